@@ -1,0 +1,14 @@
+#pragma once
+// One function per subcommand; each lives in its own cmd_<name>.cpp and only parses options and
+// calls the library. Handlers throw scanmatch::Error on failure; main prints it as one line.
+
+#include <CLI/CLI.hpp>
+
+namespace scanmatch::cli {
+
+void add_info_command(CLI::App& app);
+void add_convert_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
+void add_register_command(CLI::App& app);
+
+}  // namespace scanmatch::cli
