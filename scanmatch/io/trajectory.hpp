@@ -1,0 +1,48 @@
+#pragma once
+// Trajectories: KITTI poses (12 numbers a line, no timestamps) and TUM (t x y z qx qy qz qw).
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "scanmatch/core/se3.hpp"
+
+namespace scanmatch {
+
+enum class TrajectoryFormat { kKitti, kTum };
+
+struct Trajectory {
+  std::vector<Pose> poses;
+  std::vector<double> timestamps;  ///< empty when the file has none (KITTI)
+  std::size_t size() const { return poses.size(); }
+  bool has_timestamps() const { return !timestamps.empty(); }
+  /// Sum of the distances between consecutive positions, metres.
+  double path_length() const;
+};
+
+/// Detects the format from the content (12 vs 8 numbers a line); ".gz" allowed. Throws Error
+/// naming the file and line for a wrong field count, a non-number, a non-finite value or an
+/// invalid rotation.
+Trajectory read_trajectory(const std::string& path);
+Trajectory read_trajectory(const std::string& path, TrajectoryFormat format);
+
+/// Whole-file atomic write. TUM needs timestamps; without them the index is used as the time.
+void write_trajectory(const std::string& path, const Trajectory& trajectory,
+                      TrajectoryFormat format);
+
+/// Appends one pose a line and flushes after each, so an interrupted run keeps what it finished.
+class TrajectoryWriter {
+ public:
+  TrajectoryWriter(const std::string& path, TrajectoryFormat format);
+  ~TrajectoryWriter();
+  TrajectoryWriter(const TrajectoryWriter&) = delete;
+  TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
+  void write(const Pose& pose, double timestamp);
+
+ private:
+  std::string path_;
+  TrajectoryFormat format_;
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace scanmatch
