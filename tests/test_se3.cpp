@@ -76,8 +76,8 @@ TEST(Se3, InterpolationEndpointsAndMidpoint) {
   EXPECT_TRUE((mid.inverse() * b).isApprox(a.inverse() * mid, 1e-9));
   // Pure translation interpolates linearly.
   const Pose c = from_xyz_rpy(10, 0, 0, 0, 0, 0);
-  EXPECT_TRUE(interpolate(Pose::Identity(), c, 0.25).translation().isApprox(
-      Eigen::Vector3d(2.5, 0, 0)));
+  EXPECT_TRUE(
+      interpolate(Pose::Identity(), c, 0.25).translation().isApprox(Eigen::Vector3d(2.5, 0, 0)));
 }
 
 TEST(Se3, MatrixKittiQuaternionRoundTrips) {

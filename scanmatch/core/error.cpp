@@ -7,6 +7,8 @@ void fail(const std::string& source, const std::string& where, const std::string
   throw Error(source + ": " + where + ": " + problem);
 }
 
-void fail(const std::string& source, const std::string& problem) { fail(source, "", problem); }
+void fail(const std::string& source, const std::string& problem) {
+  fail(source, "", problem);
+}
 
 }  // namespace scanmatch

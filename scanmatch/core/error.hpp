@@ -12,8 +12,10 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Throws Error("<source>: <where>: <problem>"); `where` may be empty (e.g. "line 12", "byte 4096").
-[[noreturn]] void fail(const std::string& source, const std::string& where, const std::string& problem);
+/// Throws Error("<source>: <where>: <problem>"); `where` may be empty (e.g. "line 12", "byte
+/// 4096").
+[[noreturn]] void fail(const std::string& source, const std::string& where,
+                       const std::string& problem);
 
 /// Throws Error("<source>: <problem>").
 [[noreturn]] void fail(const std::string& source, const std::string& problem);

@@ -73,8 +73,12 @@ Pose interpolate(const Pose& a, const Pose& b, double s) {
   return a * se3_exp(s * se3_log(a.inverse() * b));
 }
 
-double rotation_angle(const Pose& T) { return so3_log(T.linear()).norm(); }
-double translation_norm(const Pose& T) { return T.translation().norm(); }
+double rotation_angle(const Pose& T) {
+  return so3_log(T.linear()).norm();
+}
+double translation_norm(const Pose& T) {
+  return T.translation().norm();
+}
 
 Pose from_matrix(const Eigen::Matrix4d& M) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(M.topLeftCorner<3, 3>(),
