@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   scanmatch::cli::add_convert_command(app);
   scanmatch::cli::add_simulate_command(app);
   scanmatch::cli::add_register_command(app);
+  scanmatch::cli::add_eval_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
@@ -27,13 +28,18 @@ struct CloudReadOptions {
 /// What a reader learned about the file beyond the points themselves.
 struct CloudFileInfo {
   CloudFormat format = CloudFormat::kPcd;
-  std::string encoding;             ///< e.g. "ascii", "binary", "binary_compressed", "binary_big_endian"
-  std::vector<std::string> fields;  ///< every field/property name in the file, in file order
+  std::string encoding;  ///< e.g. "ascii", "binary", "binary_compressed", "binary_big_endian"
+  std::vector<std::string> fields;    ///< every field/property name in the file, in file order
   std::size_t width = 0, height = 0;  ///< organised layout (height 1 when unorganised)
   std::size_t points_in_file = 0;     ///< before non-finite removal
   std::size_t non_finite = 0;         ///< points with a NaN or infinite coordinate
   bool compressed_gzip = false;
 };
+
+/// Parses a cloud already in memory (used by read_cloud and the fuzzers); `source` names it in
+/// errors.
+PointCloud parse_cloud(std::string_view bytes, CloudFormat format, const std::string& source,
+                       const CloudReadOptions& options = {}, CloudFileInfo* info = nullptr);
 
 PointCloud read_cloud(const std::string& path, const CloudReadOptions& options = {},
                       CloudFileInfo* info = nullptr);

@@ -2,7 +2,9 @@
 // Trajectories: KITTI poses (12 numbers a line, no timestamps) and TUM (t x y z qx qy qz qw).
 
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scanmatch/core/se3.hpp"
@@ -25,6 +27,10 @@ struct Trajectory {
 /// invalid rotation.
 Trajectory read_trajectory(const std::string& path);
 Trajectory read_trajectory(const std::string& path, TrajectoryFormat format);
+
+/// Parses trajectory text; `format` nullopt detects it from the first data line.
+Trajectory parse_trajectory(std::string_view text, const std::string& source,
+                            std::optional<TrajectoryFormat> format);
 
 /// Whole-file atomic write. TUM needs timestamps; without them the index is used as the time.
 void write_trajectory(const std::string& path, const Trajectory& trajectory,

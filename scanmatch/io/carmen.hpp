@@ -1,0 +1,53 @@
+#pragma once
+// CARMEN logs, the format of the classic 2D laser SLAM data sets: FLASER, ROBOTLASER1 and ODOM
+// records (read and write); other record types are counted and skipped.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace scanmatch {
+
+struct LaserScan2D {
+  double timestamp = 0.0;               ///< logger timestamp, s
+  double angle_min = -M_PI / 2;         ///< rad, angle of the first beam in the laser frame
+  double angle_increment = M_PI / 180;  ///< rad between beams
+  float max_range = 80.0f;              ///< m; readings >= max_range or <= 0 are "no return"
+  std::vector<float> ranges;            ///< m
+  std::vector<float> remissions;        ///< optional
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();       ///< x, y, theta of the laser in the log
+  Eigen::Vector3d odom_pose = Eigen::Vector3d::Zero();  ///< robot odometry x, y, theta
+};
+
+struct Odometry2D {
+  double timestamp = 0.0;
+  Eigen::Vector3d pose = Eigen::Vector3d::Zero();  ///< x, y, theta
+  double tv = 0.0, rv = 0.0, accel = 0.0;
+};
+
+struct CarmenLog {
+  std::vector<LaserScan2D> scans;
+  std::vector<Odometry2D> odometry;
+  std::size_t ignored_lines = 0;  ///< records of other types (PARAM, SYNC, ...)
+};
+
+struct CarmenReadOptions {
+  /// FLASER records carry no angles: the laser's field of view, rad. Beams are spread over it as
+  /// fov / (n - 1) for an odd count (181, 361) and fov / n for an even one (180, 360).
+  double flaser_field_of_view = M_PI;
+};
+
+CarmenLog read_carmen_log(const std::string& path, const CarmenReadOptions& options = {});
+/// Parses log text; `source_name` names it in errors.
+CarmenLog parse_carmen_log(std::string_view text, const std::string& source_name,
+                           const CarmenReadOptions& options = {});
+
+enum class CarmenLaserRecord { kFlaser, kRobotLaser1 };
+/// Whole-file atomic write; ROBOTLASER1 keeps the angles, FLASER is what old tools read.
+void write_carmen_log(const std::string& path, const CarmenLog& log,
+                      CarmenLaserRecord record = CarmenLaserRecord::kRobotLaser1);
+
+}  // namespace scanmatch
