@@ -1,0 +1,47 @@
+#pragma once
+// Small shared helpers for tests: temporary folders, writing literal files, the shared data path.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+namespace scanmatch::testing {
+
+/// A fresh folder under the system temp dir, removed when the object goes away.
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = std::filesystem::temp_directory_path() /
+            ("scanmatch_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline void write_text(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+/// ../shared relative to the repository, or empty when absent.
+inline std::string shared_data(const std::string& relative) {
+  const std::filesystem::path p =
+      std::filesystem::path(SCANMATCH_SOURCE_DIR) / ".." / "shared" / relative;
+  return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+}  // namespace scanmatch::testing
