@@ -28,25 +28,6 @@ std::vector<std::string> cloud_files_in(const fs::path& folder) {
   return files;
 }
 
-std::vector<double> read_times(const fs::path& path) {
-  const std::string text = read_file_bytes(path.string());
-  io_detail::LineCursor cursor(text);
-  std::string_view line;
-  std::vector<std::string_view> tokens;
-  std::vector<double> times;
-  while (cursor.next(line)) {
-    const std::string_view content = io_detail::trim(line);
-    if (content.empty() || content.front() == '#') continue;
-    io_detail::split_tokens(content, tokens);
-    double t;
-    if (!io_detail::parse_double(tokens[0], t) || !std::isfinite(t))
-      fail(path.string(), "line " + std::to_string(cursor.line_number()),
-           "not a time in seconds: " + io_detail::quoted(content));
-    times.push_back(t);
-  }
-  return times;
-}
-
 class FolderSequence : public SequenceSource {
  public:
   FolderSequence(std::string kind, std::string root, std::vector<std::string> files,
@@ -113,7 +94,7 @@ std::unique_ptr<SequenceSource> open_sequence_folder(const std::string& path,
   if (files.empty()) fail(path, "holds no .pcd, .ply or .bin frames");
   std::vector<double> frame_times;
   if (!times.empty() && fs::exists(times)) {
-    frame_times = read_times(times);
+    frame_times = read_times(times.string());
     if (frame_times.size() != files.size())
       fail(times.string(), "has " + std::to_string(frame_times.size()) + " times for " +
                                std::to_string(files.size()) + " frames");

@@ -94,6 +94,25 @@ Trajectory parse_trajectory(std::string_view text, const std::string& source,
   return out;
 }
 
+std::vector<double> read_times(const std::string& path) {
+  const std::string text = read_file_bytes(path);
+  LineCursor cursor(text);
+  std::string_view line;
+  std::vector<std::string_view> tokens;
+  std::vector<double> times;
+  while (cursor.next(line)) {
+    const std::string_view content = trim(line);
+    if (content.empty() || content.front() == '#') continue;
+    split_tokens(content, tokens);
+    double t;
+    if (!parse_double(tokens[0], t) || !std::isfinite(t))
+      fail(path, "line " + std::to_string(cursor.line_number()),
+           "not a time in seconds: " + quoted(content));
+    times.push_back(t);
+  }
+  return times;
+}
+
 Trajectory read_trajectory(const std::string& path) {
   return parse_trajectory(read_file_bytes(path), path, std::nullopt);
 }

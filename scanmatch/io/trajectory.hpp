@@ -32,6 +32,9 @@ Trajectory read_trajectory(const std::string& path, TrajectoryFormat format);
 Trajectory parse_trajectory(std::string_view text, const std::string& source,
                             std::optional<TrajectoryFormat> format);
 
+/// A times file (KITTI times.txt): one time in seconds per line (first column); `#` comments.
+std::vector<double> read_times(const std::string& path);
+
 /// Whole-file atomic write. TUM needs timestamps; without them the index is used as the time.
 void write_trajectory(const std::string& path, const Trajectory& trajectory,
                       TrajectoryFormat format);
