@@ -8,7 +8,10 @@
 #include <fstream>
 #include <string>
 
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cstdio>
 
 namespace scanmatch::testing {
 
@@ -42,6 +45,25 @@ inline std::string shared_data(const std::string& relative) {
   const std::filesystem::path p =
       std::filesystem::path(SCANMATCH_SOURCE_DIR) / ".." / "shared" / relative;
   return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+struct CliRun {
+  int status;
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs the built `scanmatch` CLI with `args` (shell syntax) and collects its output.
+inline CliRun run_cli(const std::string& args) {
+  const std::string command = std::string(SCANMATCH_CLI_PATH) + " " + args + " 2>&1";
+  CliRun run{-1, ""};
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return run;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) run.output.append(buffer, n);
+  const int status = pclose(pipe);
+  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
 }
 
 }  // namespace scanmatch::testing

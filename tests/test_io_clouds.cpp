@@ -173,7 +173,8 @@ TEST(Pcd, BadInputGivesClearErrors) {
   EXPECT_NE(err(head + "DATA ascii\n1 2 3\n4 5 6\n7 8 9\n1 1 1\n").find("more data rows"),
             std::string::npos);
   EXPECT_NE(err(head + "DATA ascii\n1 2 3\n4 x 6\n7 8 9\n").find("line 9"), std::string::npos);
-  EXPECT_NE(err(head + "DATA ascii\n1 2 3\n1 2\n4 5 6\n").find("expected 3 values"), std::string::npos);
+  EXPECT_NE(err(head + "DATA ascii\n1 2 3\n1 2\n4 5 6\n").find("expected 3 values"),
+            std::string::npos);
   EXPECT_NE(err(head + "DATA binary\n" + std::string(20, '\0')).find("truncated"),
             std::string::npos);
   EXPECT_NE(err(head + "DATA lzma\n").find("unknown DATA"), std::string::npos);
@@ -370,4 +371,12 @@ TEST(RealData, ReadsHdl32PlyAndCarCsv) {
   const PointCloud car = read_cloud(csv);
   EXPECT_GT(car.size(), 1000u);
   EXPECT_FALSE(car.has_intensity());
+}
+
+TEST(Parsers, CloudLinesOfOnlySeparatorsAreSkipped) {
+  EXPECT_EQ(parse_cloud(",,;\n1 2 3\n", CloudFormat::kText, "sep.csv").size(), 1u);
+  EXPECT_EQ(parse_cloud(",,\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n1 2 3\n",
+                        CloudFormat::kPcd, "sep.pcd")
+                .size(),
+            1u);
 }

@@ -218,3 +218,10 @@ TEST(Sequence, FolderKittiAndDataSetLayouts) {
             std::string::npos);
   EXPECT_THROW(open_sequence_folder(dir.file("missing")), Error);
 }
+
+TEST(Parsers, LinesOfOnlySeparatorsAreSkippedNotCrashes) {
+  // Found by fuzzing: a line of separators tokenises to nothing.
+  EXPECT_THROW(parse_carmen_log("; \n,,\n", "sep.log"), Error);
+  EXPECT_EQ(parse_carmen_log(";\nODOM 1 2 3 0 0 0 1 h 1\n", "sep.log").odometry.size(), 1u);
+  EXPECT_EQ(parse_trajectory(",,\n1 0 0 0 0 1 0 0 0 0 1 0\n", "sep.txt", std::nullopt).size(), 1u);
+}

@@ -62,6 +62,7 @@ CarmenLog parse_carmen_log(std::string_view text, const std::string& source,
     const std::string_view content = trim(line);
     if (content.empty() || content.front() == '#') continue;
     split_tokens(content, tokens);
+    if (tokens.empty()) continue;  // only separators
     const Fields f(tokens, source, "line " + std::to_string(cursor.line_number()));
     if (tokens[0] == "FLASER" || tokens[0] == "RLASER") {
       const std::size_t n = f.count(1);

@@ -64,6 +64,7 @@ PointCloud parse_text(std::string_view bytes, const std::string& source,
     const std::string_view content = trim(line);
     if (content.empty() || content.front() == '#' || content.substr(0, 2) == "//") continue;
     split_tokens(content, tokens);
+    if (tokens.empty()) continue;  // only separators
     if (!layout_known) {
       double probe;
       if (!parse_double(tokens[0], probe)) {

@@ -41,6 +41,7 @@ PcdHeader parse_header(std::string_view bytes, const std::string& source) {
     line = trim(line);
     if (line.empty() || line.front() == '#') continue;
     split_tokens(line, tokens);
+    if (tokens.empty()) continue;  // only separators
     const std::string_view key = tokens[0];
     const auto want_numbers = [&](std::uint64_t& value) {
       if (tokens.size() != 2 || !parse_count(tokens[1], value))
@@ -178,6 +179,7 @@ PointCloud parse_pcd(std::string_view bytes, const std::string& source,
         fail(source, where,
              "more data rows than the " + std::to_string(h.points) + " POINTS declared");
       split_tokens(line, tokens);
+      if (tokens.empty()) continue;  // only separators
       if (tokens.size() != values_per_point)
         fail(source, where,
              "expected " + std::to_string(values_per_point) + " values, found " +

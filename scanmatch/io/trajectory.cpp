@@ -52,6 +52,7 @@ Trajectory parse_trajectory(std::string_view text, const std::string& source,
     const std::string_view content = trim(line);
     if (content.empty() || content.front() == '#') continue;
     split_tokens(content, tokens);
+    if (tokens.empty()) continue;  // only separators
     if (!format) {
       if (tokens.size() == 12)
         format = TrajectoryFormat::kKitti;
@@ -104,6 +105,7 @@ std::vector<double> read_times(const std::string& path) {
     const std::string_view content = trim(line);
     if (content.empty() || content.front() == '#') continue;
     split_tokens(content, tokens);
+    if (tokens.empty()) continue;  // only separators
     double t;
     if (!parse_double(tokens[0], t) || !std::isfinite(t))
       fail(path, "line " + std::to_string(cursor.line_number()),

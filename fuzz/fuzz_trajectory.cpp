@@ -1,0 +1,16 @@
+// libFuzzer target: trajectory text must be parsed or rejected with scanmatch::Error.
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/io/trajectory.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    scanmatch::parse_trajectory(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz",
+                                std::nullopt);
+  } catch (const scanmatch::Error&) {
+  }
+  return 0;
+}
