@@ -1,0 +1,81 @@
+#pragma once
+// The LiDAR simulator: a preset (scene + sensor + motion) rendered frame by frame with exact
+// ground truth, written as a data set or streamed as a SequenceSource (`sim:PRESET`).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scanmatch/io/carmen.hpp"
+#include "scanmatch/io/sequence.hpp"
+#include "scanmatch/sim/motion.hpp"
+#include "scanmatch/sim/sensor.hpp"
+#include "scanmatch/sim/worlds.hpp"
+
+namespace scanmatch::sim {
+
+struct SimOptions {
+  std::string preset = "dynamic-outdoor";
+  std::string sensor;                 ///< empty: the preset's sensor
+  std::optional<std::size_t> frames;  ///< truncate (or extend a still preset) to this many frames
+  std::uint64_t seed = 1;
+  bool motion_distortion = true;  ///< each point measured from the pose at its own time
+  bool noise = true;              ///< range noise and dropouts
+  std::string trajectory_file;    ///< replay this KITTI/TUM trajectory instead of the preset's path
+};
+
+struct PresetInfo {
+  std::string name, scene, sensor, motion, description;
+  std::size_t frames = 0;
+  double path_length = 0.0;  ///< m, 0 for still presets
+};
+const std::vector<PresetInfo>& presets();
+/// Throws Error naming the valid presets.
+const PresetInfo& preset_info(const std::string& name);
+
+class Simulator {
+ public:
+  explicit Simulator(const SimOptions& options);
+
+  std::size_t size() const { return frames_; }
+  const SensorModel& sensor() const { return *sensor_; }
+  const PresetInfo& preset() const { return *preset_; }
+  const SimOptions& options() const { return options_; }
+  const World& world() const { return world_; }
+  double frame_time(std::size_t i) const {
+    return static_cast<double>(i) * sensor_->frame_period();
+  }
+
+  /// Sensor pose in the scene at time t (s since the first frame).
+  Pose scene_pose_at(double t) const { return motion_.at(t); }
+  /// Ground truth of frame i: sensor pose at the frame's start in the world frame of frame 0.
+  Pose pose(std::size_t i) const;
+  Trajectory ground_truth() const;
+  double path_length() const;
+
+  /// Frame i: x y z intensity ring t, points in the sensor frame at their own measurement time.
+  PointCloud frame(std::size_t i) const;
+  /// Frame i of a 2D sensor as a CARMEN scan (ranges over 360 degrees, max_range = no return).
+  LaserScan2D scan_2d(std::size_t i) const;
+
+ private:
+  SimOptions options_;
+  const PresetInfo* preset_;
+  const SensorModel* sensor_;
+  World world_;
+  DenseTrajectory motion_;
+  std::size_t frames_ = 0;
+  Pose first_inverse_ = Pose::Identity();
+};
+
+/// Writes frames/NNNNNN.pcd (or scans.log for 2D), poses_gt.txt, poses_gt_tum.txt, times.txt and
+/// dataset.json into `folder` (created). Progress on a terminal unless `quiet`.
+void write_dataset(const Simulator& simulator, const std::string& folder, bool quiet);
+
+/// `sim:PRESET` generates frames on the fly (options.preset is replaced by PRESET); anything else
+/// is opened with open_sequence_folder.
+std::unique_ptr<SequenceSource> open_sequence(const std::string& spec, SimOptions options = {});
+
+}  // namespace scanmatch::sim

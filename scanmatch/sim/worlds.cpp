@@ -1,0 +1,228 @@
+#include "scanmatch/sim/worlds.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "scanmatch/sim/random.hpp"
+
+namespace scanmatch::sim {
+namespace {
+constexpr double kWall = 0.1;  // wall half-thickness is kWall / 2
+
+// A wall segment from a to b (ground plane), between heights z0 and z1.
+void wall(Scene& scene, Eigen::Vector2d a, Eigen::Vector2d b, double z0, double z1,
+          float reflectivity = 0.6f) {
+  const Eigen::Vector2d d = b - a;
+  Box box;
+  box.center = Eigen::Vector3d(0.5 * (a.x() + b.x()), 0.5 * (a.y() + b.y()), 0.5 * (z0 + z1));
+  box.half_size = Eigen::Vector3d(0.5 * d.norm() + 0.5 * kWall, 0.5 * kWall, 0.5 * (z1 - z0));
+  box.yaw = std::atan2(d.y(), d.x());
+  box.reflectivity = reflectivity;
+  scene.add(box);
+}
+
+// A wall along x or y with door gaps: `gaps` are (centre, width) along the wall.
+void wall_with_doors(Scene& scene, Eigen::Vector2d a, Eigen::Vector2d b,
+                     std::vector<std::pair<double, double>> gaps, double z0, double z1) {
+  const double length = (b - a).norm();
+  const Eigen::Vector2d u = (b - a) / length;
+  double start = 0.0;
+  std::sort(gaps.begin(), gaps.end());
+  for (const auto& [centre, width] : gaps) {
+    const double stop = centre - 0.5 * width;
+    if (stop > start + 0.05) wall(scene, a + start * u, a + stop * u, z0, z1);
+    start = centre + 0.5 * width;
+  }
+  if (length > start + 0.05) wall(scene, a + start * u, b, z0, z1);
+}
+
+void box_at(Scene& scene, double x, double y, double z0, Eigen::Vector3d size, double yaw,
+            float refl) {
+  Box b;
+  b.center = Eigen::Vector3d(x, y, z0 + 0.5 * size.z());
+  b.half_size = 0.5 * size;
+  b.yaw = yaw;
+  b.reflectivity = refl;
+  scene.add(b);
+}
+
+// Furniture of a hall: desks and cabinets along its long walls, pillars inside, all clear of the
+// central aisle (|y - aisle_y| > clear).
+void furnish_hall(Scene& scene, Rng& rng, double x0, double x1, double y0, double y1,
+                  double height) {
+  for (double x = x0 + 1.5; x < x1 - 1.5; x += rng.uniform(2.2, 3.2)) {
+    box_at(scene, x, y1 - 0.6, 0.0, {1.6, 0.8, 0.75}, rng.uniform(-0.1, 0.1), 0.5f);      // desk
+    box_at(scene, x + 0.3, y0 + 0.4, 0.0, {0.9, 0.5, rng.uniform(1.2, 2.0)}, 0.0, 0.7f);  // cabinet
+  }
+  for (double x = x0 + 3.0; x < x1 - 2.0; x += 4.0)
+    for (double y : {y0 + 2.5, y1 - 2.5}) scene.add(Cylinder{{x, y}, 0.25, 0.0, height, 0.5f});
+}
+}  // namespace
+
+World make_office(std::uint64_t seed) {
+  Rng rng(hash_combine(seed, 0x0FF1CE));
+  World w;
+  Scene& s = w.scene;
+  const double h = 3.0;
+  Ground floor;
+  floor.half_extent = 80;
+  floor.cell = 10;  // flat: large triangles suffice
+  floor.reflectivity = 0.3f;
+  s.set_ground(floor);
+  box_at(s, 18, 0, h, {80, 30, 0.2}, 0.0, 0.4f);  // ceiling slab over everything
+  // Lobby x in [-12, 0], end hall x in [36, 48], both y in [-8, 8]; corridor y in [-1.25, 1.25].
+  for (double xa : {-12.0, 36.0}) {
+    const double xb = xa + 12.0;
+    wall(s, {xa, -8}, {xb, -8}, 0, h);
+    wall(s, {xa, 8}, {xb, 8}, 0, h);
+    // Outer end wall is solid; the wall facing the corridor has the corridor opening.
+    const double outer = xa < 0 ? xa : xb, inner = xa < 0 ? xb : xa;
+    wall(s, {outer, -8}, {outer, 8}, 0, h);
+    wall_with_doors(s, {inner, -8}, {inner, 8}, {{8.0, 2.5}}, 0, h);
+    furnish_hall(s, rng, xa, xb, -8, 8, h);
+    // A few boxes and a side room door frame give the halls structure in every direction.
+    box_at(s, 0.5 * (xa + xb) + rng.uniform(-2, 2), -5.5, 0, {1.2, 1.2, 1.0}, rng.uniform(0, 1),
+           0.6f);
+    box_at(s, 0.5 * (xa + xb) + rng.uniform(-2, 2), 5.5, 0, {0.6, 2.0, 1.8}, rng.uniform(0, 1),
+           0.6f);
+  }
+  // The corridor: plain walls, 36 m long.
+  wall(s, {0, -1.25}, {36, -1.25}, 0, h, 0.65f);
+  wall(s, {0, 1.25}, {36, 1.25}, 0, h, 0.65f);
+  w.loop = {{-9, -5}, {-9, 5},  {-3, 5},  {-2, 0.45},  {38, 0.45},  {40, 5},
+            {45, 5},  {45, -5}, {40, -5}, {38, -0.45}, {-2, -0.45}, {-3, -5}};
+  w.still_position = Eigen::Vector3d(-6, 1.5, 0.3);
+  s.commit();
+  return w;
+}
+
+World make_campus(std::uint64_t seed) {
+  Rng rng(hash_combine(seed, 0xCA4B05));
+  World w;
+  Scene& s = w.scene;
+  Ground ground;
+  ground.slope_x = 0.01;
+  ground.slope_y = -0.005;
+  ground.amplitude = 0.25;
+  ground.wavelength = 25;
+  ground.half_extent = 140;
+  ground.cell = 2;
+  s.set_ground(ground);
+  const auto gz = [&](double x, double y) { return ground.height(x, y); };
+  // Road loop: rectangle with corners (+-60, +-40); road half-width 4 m, kerbs at 4.5 m.
+  const double rx = 60, ry = 40;
+  w.loop = {{-rx, -ry}, {rx, -ry}, {rx, ry}, {-rx, ry}};
+  w.still_position = Eigen::Vector3d(-20, -ry + 1.5, 0.2);
+  // Kerbs on both sides of each straight road, as short segments following the ground.
+  const auto kerb_line = [&](Eigen::Vector2d a, Eigen::Vector2d b) {
+    const int n = static_cast<int>((b - a).norm() / 4.0);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d p = a + (b - a) * ((i + 0.5) / n);
+      const Eigen::Vector2d d = (b - a).normalized();
+      box_at(s, p.x(), p.y(), gz(p.x(), p.y()) - 0.1, {(b - a).norm() / n - 0.02, 0.3, 0.25},
+             std::atan2(d.y(), d.x()), 0.35f);
+    }
+  };
+  for (double off : {-4.5, 4.5}) {
+    kerb_line({-rx + 8, -ry + off}, {rx - 8, -ry + off});
+    kerb_line({-rx + 8, ry + off}, {rx - 8, ry + off});
+    kerb_line({-rx + off, -ry + 8}, {-rx + off, ry - 8});
+    kerb_line({rx + off, -ry + 8}, {rx + off, ry - 8});
+  }
+  // Buildings outside and inside the loop, set back from the road, with recesses and sills.
+  const auto building = [&](double x, double y, double sx, double sy, double yaw) {
+    const double base = gz(x, y) - 1.0, height = rng.uniform(8, 20);
+    box_at(s, x, y, base, {sx, sy, height + 1.0}, yaw, 0.55f);
+    const Eigen::Vector2d along(std::cos(yaw), std::sin(yaw)),
+        across(-std::sin(yaw), std::cos(yaw));
+    // An entrance block protruding from the facade and window sills in rows.
+    for (double side : {-1.0, 1.0}) {
+      const Eigen::Vector2d face = Eigen::Vector2d(x, y) + side * 0.5 * sy * across;
+      const Eigen::Vector2d e = face + side * 0.75 * across + rng.uniform(-0.3, 0.3) * sx * along;
+      box_at(s, e.x(), e.y(), gz(e.x(), e.y()) - 0.5, {rng.uniform(3, 6), 1.5, 4.0}, yaw, 0.5f);
+      for (double level = 3.0; level < height - 1.0; level += 3.2)
+        for (double u = -0.5 * sx + 2.0; u < 0.5 * sx - 1.5; u += 3.0) {
+          const Eigen::Vector2d c = face + u * along + side * 0.15 * across;
+          box_at(s, c.x(), c.y(), base + 1.0 + level, {1.4, 0.3, 0.12}, yaw, 0.7f);
+        }
+    }
+  };
+  for (double x = -rx + 10; x < rx - 10; x += rng.uniform(22, 30)) {
+    building(x, -ry - 16 - rng.uniform(0, 4), rng.uniform(12, 18), rng.uniform(8, 12),
+             rng.uniform(-0.05, 0.05));
+    building(x + 5, ry + 16 + rng.uniform(0, 4), rng.uniform(12, 18), rng.uniform(8, 12),
+             rng.uniform(-0.05, 0.05));
+    building(x + 3, -ry + 18 + rng.uniform(0, 3), rng.uniform(10, 14), rng.uniform(8, 10), 0.0);
+    building(x - 2, ry - 18 - rng.uniform(0, 3), rng.uniform(10, 14), rng.uniform(8, 10), 0.0);
+  }
+  for (double y = -ry + 12; y < ry - 12; y += rng.uniform(20, 28)) {
+    building(-rx - 16 - rng.uniform(0, 4), y, rng.uniform(8, 12), rng.uniform(12, 18), 0.0);
+    building(rx + 16 + rng.uniform(0, 4), y, rng.uniform(8, 12), rng.uniform(12, 18), 0.0);
+  }
+  // Trees, poles and parked cars along the roads; a fence along part of each side.
+  const auto roadside = [&](Eigen::Vector2d a, Eigen::Vector2d b, Eigen::Vector2d outward) {
+    const double length = (b - a).norm();
+    const Eigen::Vector2d u = (b - a) / length;
+    for (double t = rng.uniform(2, 6); t < length; t += rng.uniform(9, 15)) {
+      const Eigen::Vector2d p = a + t * u + outward * rng.uniform(6.5, 8.0);
+      const double z = gz(p.x(), p.y());
+      const double trunk = rng.uniform(2.0, 3.5);
+      s.add(Cylinder{p, rng.uniform(0.12, 0.25), z - 0.2, z + trunk, 0.35f});
+      s.add(Ellipsoid{Eigen::Vector3d(p.x(), p.y(), z + trunk + 1.2),
+                      Eigen::Vector3d(2.0, 2.0, 1.6) * rng.uniform(0.8, 1.3), 0.25f});
+    }
+    for (double t = rng.uniform(5, 15); t < length; t += rng.uniform(25, 35)) {
+      const Eigen::Vector2d p = a + t * u + outward * 5.2;
+      s.add(Cylinder{p, 0.08, gz(p.x(), p.y()) - 0.2, gz(p.x(), p.y()) + 6.0, 0.6f});
+    }
+    for (double t = rng.uniform(8, 20); t < length - 8; t += rng.uniform(14, 30)) {
+      const Eigen::Vector2d p = a + t * u + outward * 3.2;  // parked on the road's edge
+      const double yaw = std::atan2(u.y(), u.x());
+      box_at(s, p.x(), p.y(), gz(p.x(), p.y()) + 0.25, {4.4, 1.8, 0.8}, yaw, 0.8f);
+      box_at(s, p.x(), p.y(), gz(p.x(), p.y()) + 1.05, {2.4, 1.6, 0.6}, yaw, 0.8f);
+    }
+    const double f0 = rng.uniform(0.1, 0.4) * length, f1 = f0 + rng.uniform(0.2, 0.4) * length;
+    for (double t = f0; t < std::min(f1, length); t += 2.5) {
+      const Eigen::Vector2d p = a + (t + 1.25) * u + outward * 9.5;
+      box_at(s, p.x(), p.y(), gz(p.x(), p.y()) - 0.1, {2.45, 0.05, 1.3}, std::atan2(u.y(), u.x()),
+             0.45f);
+    }
+  };
+  roadside({-rx + 6, -ry}, {rx - 6, -ry}, {0, -1});
+  roadside({-rx + 6, -ry}, {rx - 6, -ry}, {0, 1});
+  roadside({-rx + 6, ry}, {rx - 6, ry}, {0, 1});
+  roadside({-rx + 6, ry}, {rx - 6, ry}, {0, -1});
+  roadside({-rx, -ry + 6}, {-rx, ry - 6}, {-1, 0});
+  roadside({-rx, -ry + 6}, {-rx, ry - 6}, {1, 0});
+  roadside({rx, -ry + 6}, {rx, ry - 6}, {1, 0});
+  roadside({rx, -ry + 6}, {rx, ry - 6}, {-1, 0});
+  s.commit();
+  return w;
+}
+
+World make_rooms_2d(std::uint64_t seed) {
+  Rng rng(hash_combine(seed, 0x2D2D));
+  World w;
+  Scene& s = w.scene;
+  const double h = 1.0;
+  // Three rooms in a row (5 m x 4 m each) and a hallway along y = 4..6.
+  wall(s, {0, 0}, {15, 0}, 0, h);
+  wall(s, {0, 0}, {0, 6}, 0, h);
+  wall(s, {15, 0}, {15, 6}, 0, h);
+  wall(s, {0, 6}, {15, 6}, 0, h);
+  for (double x : {5.0, 10.0}) wall(s, {x, 0}, {x, 4}, 0, h);
+  wall_with_doors(s, {0, 4}, {15, 4}, {{2.5, 1.2}, {7.5, 1.2}, {12.5, 1.2}}, 0, h);
+  for (int room = 0; room < 3; ++room) {
+    const double x0 = 5.0 * room;
+    box_at(s, x0 + rng.uniform(0.8, 1.5), rng.uniform(0.6, 1.0), 0, {1.0, 0.6, 0.8}, 0.0, 0.5f);
+    box_at(s, x0 + rng.uniform(3.2, 4.2), rng.uniform(2.0, 3.0), 0, {0.5, 0.5, 0.5},
+           rng.uniform(0, 1.5), 0.5f);
+  }
+  w.loop = {{1.5, 5.0}, {2.5, 2.5},  {2.5, 5.0},  {7.5, 5.0}, {7.5, 2.2},
+            {7.5, 5.0}, {12.5, 5.0}, {12.5, 2.0}, {13.5, 5.2}};
+  w.still_position = Eigen::Vector3d(2.5, 2.0, 0.0);
+  s.commit();
+  return w;
+}
+
+}  // namespace scanmatch::sim
