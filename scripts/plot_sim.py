@@ -35,6 +35,33 @@ def read_kitti(path):
     return poses
 
 
+def plot_planar(dataset, out, title, every):
+    """2D data sets: ROBOTLASER1 scans placed at their ground-truth poses."""
+    points, path = [], []
+    with open(os.path.join(dataset, "scans.log")) as f:
+        for i, line in enumerate(l for l in f if l.startswith("ROBOTLASER1")):
+            v = line.split()
+            start, step, n = float(v[2]), float(v[4]), int(v[8])
+            ranges = np.array([float(x) for x in v[9:9 + n]])
+            nr = int(v[9 + n])
+            x, y, th = (float(a) for a in v[10 + n + nr:13 + n + nr])
+            path.append((x, y))
+            if i % every:
+                continue
+            ok = ranges < float(v[5])
+            a = start + step * np.arange(n) + th
+            points.append(np.stack([x + ranges[ok] * np.cos(a[ok]), y + ranges[ok] * np.sin(a[ok])], 1))
+    pts, path = np.concatenate(points), np.array(path)
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    ax.scatter(pts[:, 0], pts[:, 1], s=0.3, c="k")
+    ax.plot(path[:, 0], path[:, 1], "r-", lw=1, label="ground truth path")
+    ax.set_aspect("equal")
+    ax.set_title(f"{title}: scans placed at their ground-truth poses")
+    ax.legend(loc="upper right")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("dataset")
@@ -42,10 +69,14 @@ def main():
     ap.add_argument("--every", type=int, default=10)
     ap.add_argument("--title", default="")
     ap.add_argument("--pattern", action="store_true")
+    ap.add_argument("--max-z", type=float, default=None, help="top view: drop points above (ceilings)")
     args = ap.parse_args()
     info = json.load(open(os.path.join(args.dataset, "dataset.json")))
-    frames = sorted(os.listdir(os.path.join(args.dataset, "frames")))
     title = args.title or f"{info['preset']} ({info['sensor']})"
+    if os.path.exists(os.path.join(args.dataset, "scans.log")):
+        plot_planar(args.dataset, args.out, title, args.every)
+        return
+    frames = sorted(os.listdir(os.path.join(args.dataset, "frames")))
     if args.pattern:
         fig, axes = plt.subplots(1, 2, figsize=(12, 3.6))
         for ax, count in zip(axes, [1, 5]):
@@ -69,8 +100,9 @@ def main():
         clouds.append(xyz @ poses[i][:3, :3].T + poses[i][:3, 3])
     cloud = np.concatenate(clouds)
     fig, (top, side) = plt.subplots(1, 2, figsize=(13, 5), gridspec_kw={"width_ratios": [1.3, 1]})
-    order = np.argsort(cloud[:, 2])
-    top.scatter(cloud[order, 0], cloud[order, 1], c=cloud[order, 2], s=0.05, cmap="viridis")
+    below = cloud if args.max_z is None else cloud[cloud[:, 2] < args.max_z]
+    order = np.argsort(below[:, 2])
+    top.scatter(below[order, 0], below[order, 1], c=below[order, 2], s=0.05, cmap="viridis")
     top.plot(poses[:, 0, 3], poses[:, 1, 3], "r-", lw=1, label="ground truth path")
     top.set_aspect("equal")
     top.set_title(f"{title}: top view, {len(clouds)} frames accumulated")
