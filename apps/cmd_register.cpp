@@ -1,11 +1,142 @@
+// `scanmatch register SOURCE TARGET --method NAME`: the transform that maps SOURCE into TARGET.
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/io/cloud_io.hpp"
+#include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch::cli {
+namespace {
+
+struct RegisterCommand {
+  std::string source, target, init, kernel = "none";
+  double voxel = 0.1;
+  bool json = false;
+  RegistrationOptions options;
+};
+
+// "16 numbers" (row-major 4x4) or "x,y,z,roll,pitch,yaw" (metres and degrees).
+Pose parse_initial_guess(const std::string& text) {
+  std::string s = text;
+  for (char& c : s)
+    if (c == ',' || c == ';') c = ' ';
+  std::istringstream in(s);
+  std::vector<double> v;
+  std::string token;
+  while (in >> token) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(token, &used));
+      if (used != token.size()) throw std::invalid_argument(token);
+    } catch (const std::exception&) {
+      throw Error("--init: not a number: '" + token + "'");
+    }
+  }
+  for (double x : v)
+    if (!std::isfinite(x)) throw Error("--init: the initial guess contains a non-finite value");
+  if (v.size() == 6)
+    return from_xyz_rpy(v[0], v[1], v[2], v[3] * M_PI / 180, v[4] * M_PI / 180, v[5] * M_PI / 180);
+  if (v.size() == 16) {
+    Eigen::Matrix4d M;
+    for (int i = 0; i < 16; ++i) M(i / 4, i % 4) = v[static_cast<std::size_t>(i)];
+    if (!is_valid_pose(M, 1e-3)) throw Error("--init: the 4x4 matrix is not a rigid transform");
+    return from_matrix(M);
+  }
+  throw Error(
+      "--init: expected 16 numbers (a 4x4 matrix) or 6 (x,y,z,roll,pitch,yaw in degrees), got " +
+      std::to_string(v.size()));
+}
+
+void run(RegisterCommand& c) {
+  const Pose initial = c.init.empty() ? Pose::Identity() : parse_initial_guess(c.init);
+  PointCloud source = read_cloud(c.source), target = read_cloud(c.target);
+  if (source.empty()) throw Error(c.source + ": the cloud is empty");
+  if (target.empty()) throw Error(c.target + ": the cloud is empty");
+  if (c.voxel > 0.0) {
+    source = voxel_downsample(source, c.voxel);
+    target = voxel_downsample(target, c.voxel);
+  }
+  c.options.solver.kernel.type = parse_kernel(c.kernel);
+  const auto start = std::chrono::steady_clock::now();
+  const RegistrationResult r = register_clouds(source, target, c.options, initial);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::size_t matched = 0;
+  const double fitness =
+      fitness_score(source, target, r.transform, c.options.max_correspondence_distance, &matched);
+  const Eigen::Matrix4d M = to_matrix(r.transform);
+  if (c.json) {
+    nlohmann::ordered_json j;
+    j["method"] = c.options.method;
+    j["transform"] = std::vector<std::vector<double>>{{M(0, 0), M(0, 1), M(0, 2), M(0, 3)},
+                                                      {M(1, 0), M(1, 1), M(1, 2), M(1, 3)},
+                                                      {M(2, 0), M(2, 1), M(2, 2), M(2, 3)},
+                                                      {M(3, 0), M(3, 1), M(3, 2), M(3, 3)}};
+    j["iterations"] = r.iterations;
+    j["converged"] = r.converged;
+    j["stop_reason"] = r.stop_reason;
+    j["time_ms"] = ms;
+    j["fitness"] = fitness;
+    j["correspondences"] = r.inliers;
+    j["condition_number"] = std::isfinite(r.condition_number) ? r.condition_number : -1.0;
+    j["source_points"] = source.size();
+    j["target_points"] = target.size();
+    fmt::print("{}\n", j.dump(2));
+    return;
+  }
+  for (int i = 0; i < 4; ++i)
+    fmt::print("{:12.8f} {:12.8f} {:12.8f} {:12.8f}\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
+  fmt::print(
+      "method {}: {} iterations, {}, {:.1f} ms\n", c.options.method, r.iterations,
+      r.converged ? "converged (" + r.stop_reason + ")" : "not converged (" + r.stop_reason + ")",
+      ms);
+  fmt::print("fitness {:.6g} m^2 over {} of {} points; condition number {:.4g}\n", fitness, matched,
+             source.size(), r.condition_number);
+}
+
+}  // namespace
 
 void add_register_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("register", "(not implemented yet)");
-  cmd->callback([] { throw Error("register: not implemented yet"); });
+  auto c = std::make_shared<RegisterCommand>();
+  std::string methods;
+  for (const auto& m : registration_method_names()) methods += (methods.empty() ? "" : ", ") + m;
+  auto* cmd = app.add_subcommand(
+      "register",
+      "Register SOURCE onto TARGET; prints the 4x4 transform mapping SOURCE into TARGET");
+  cmd->add_option("SOURCE", c->source, "Source cloud")->required();
+  cmd->add_option("TARGET", c->target, "Target cloud")->required();
+  cmd->add_option("--method", c->options.method, "One of: " + methods)->capture_default_str();
+  cmd->add_option("--init", c->init,
+                  "Initial guess: 16 numbers (row-major 4x4) or x,y,z,roll,pitch,yaw (m, deg)");
+  cmd->add_option("--voxel", c->voxel, "Voxel downsampling of both clouds, m (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--threads", c->options.solver.num_threads, "Threads for linearisation")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", c->options.solver.max_iterations, "Iteration limit")
+      ->capture_default_str();
+  cmd->add_option("--max-distance", c->options.max_correspondence_distance,
+                  "Correspondence distance, m")
+      ->capture_default_str();
+  cmd->add_option("--resolution", c->options.voxel_resolution,
+                  "Gaussian voxel size for vgicp, ndt, ctf-fine, m")
+      ->capture_default_str();
+  cmd->add_option("--neighbours", c->options.voxel_neighbours,
+                  "Voxels per point: 1, 7 or 27 (0: method default)");
+  cmd->add_option("--kernel", c->kernel, "Robust kernel: none, huber, cauchy, tukey, geman-mcclure")
+      ->capture_default_str();
+  cmd->add_option("--kernel-scale", c->options.solver.kernel.scale, "Robust kernel scale, m")
+      ->capture_default_str();
+  cmd->add_flag("--lm", c->options.solver.levenberg_marquardt,
+                "Levenberg-Marquardt instead of Gauss-Newton");
+  cmd->add_flag("--json", c->json, "Print JSON");
+  cmd->callback([c] { run(*c); });
 }
 
 }  // namespace scanmatch::cli

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "scanmatch/core/alignment.hpp"
 #include "scanmatch/core/se3.hpp"
 #include "scanmatch/io/trajectory.hpp"
 
@@ -15,14 +16,6 @@ namespace scanmatch {
 enum class Alignment { kNone, kSe3, kSim3 };
 Alignment parse_alignment(const std::string& name);  ///< "none", "se3", "sim3"; throws Error
 const char* to_string(Alignment alignment);
-
-/// Least-squares similarity (Umeyama 1991) mapping `from` onto `to`: to ~ s R from + t.
-struct Similarity {
-  Pose transform = Pose::Identity();  ///< rotation and translation
-  double scale = 1.0;
-};
-Similarity umeyama_alignment(const std::vector<Eigen::Vector3d>& from,
-                             const std::vector<Eigen::Vector3d>& to, bool with_scale);
 
 struct AteResult {
   std::size_t poses = 0;

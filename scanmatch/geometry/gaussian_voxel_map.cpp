@@ -1,0 +1,132 @@
+#include "scanmatch/geometry/gaussian_voxel_map.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "scanmatch/core/error.hpp"
+
+namespace scanmatch {
+
+GaussianVoxelMap::GaussianVoxelMap(const GaussianVoxelMapOptions& options) : options_(options) {
+  if (!(options.voxel_size > 0.0)) throw Error("Gaussian voxel map: voxel size must be positive");
+  if (options.merge_threshold == 0)
+    throw Error("Gaussian voxel map: merge threshold must be at least 1");
+}
+
+VoxelIndex GaussianVoxelMap::index_of(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d s = p / options_.voxel_size;
+  return {static_cast<std::int32_t>(std::floor(s.x())),
+          static_cast<std::int32_t>(std::floor(s.y())),
+          static_cast<std::int32_t>(std::floor(s.z()))};
+}
+
+const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {
+  const auto it = voxels_.find(index_of(p));
+  return it != voxels_.end() && it->second.count >= options_.min_points ? &it->second : nullptr;
+}
+
+const std::vector<std::array<int, 3>>& GaussianVoxelMap::offsets(int neighbours) {
+  static const std::vector<std::array<int, 3>> one = {{0, 0, 0}};
+  static const std::vector<std::array<int, 3>> seven = {
+      {0, 0, 0}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  static const std::vector<std::array<int, 3>> all = [] {
+    std::vector<std::array<int, 3>> v;
+    for (int x = -1; x <= 1; ++x)
+      for (int y = -1; y <= 1; ++y)
+        for (int z = -1; z <= 1; ++z) v.push_back({x, y, z});
+    return v;
+  }();
+  return neighbours >= 27 ? all : neighbours >= 7 ? seven : one;
+}
+
+void GaussianVoxelMap::merge(GaussianVoxel& v, std::uint32_t n, const Eigen::Vector3d& mean,
+                             const Eigen::Matrix3d& covariance) {
+  if (n == 0) return;
+  if (v.count == 0) {
+    v.count = n;
+    v.mean = mean;
+    v.covariance = covariance;
+    return;
+  }
+  const double m = v.count, k = n, total = m + k;
+  const Eigen::Vector3d d = v.mean - mean;
+  v.covariance = (m * v.covariance + k * covariance + (m * k / total) * d * d.transpose()) / total;
+  v.mean = (m * v.mean + k * mean) / total;
+  v.count += n;
+}
+
+void GaussianVoxelMap::update_cache(GaussianVoxel& v) const {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(v.covariance);
+  const Eigen::Matrix3d& Q = solver.eigenvectors();  // ascending eigenvalues
+  v.normal = Q.col(0);
+  const double eps = options_.planar_epsilon;
+  v.planar_information = Q * Eigen::Vector3d(1.0 / eps, 1.0, 1.0).asDiagonal() * Q.transpose();
+  const Eigen::Vector3d lambda =
+      solver.eigenvalues().cwiseMax(1e-3 * std::max(solver.eigenvalues()(2), 1e-6));
+  v.regularized_covariance = Q * lambda.asDiagonal() * Q.transpose();
+  v.regularized_information = Q * lambda.cwiseInverse().asDiagonal() * Q.transpose();
+}
+
+void GaussianVoxelMap::merge_pending(const VoxelIndex& index, GaussianVoxel& v) {
+  if (v.pending == 0) return;
+  const Eigen::Vector3d corner = Eigen::Vector3d(index.x, index.y, index.z) * options_.voxel_size;
+  const double n = v.pending;
+  const Eigen::Vector3d local_mean = v.pending_sum / n;
+  const Eigen::Matrix3d covariance = v.pending_outer / n - local_mean * local_mean.transpose();
+  merge(v, v.pending, corner + local_mean, covariance);
+  v.pending = 0;
+  v.pending_sum.setZero();
+  v.pending_outer.setZero();
+  update_cache(v);
+}
+
+std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) {
+  std::vector<VoxelIndex> touched;
+  touched.reserve(cloud.size() / 4 + 1);
+  for (const Point& point : cloud.points) {
+    const Eigen::Vector3d p = pose * point.cast<double>();
+    if (!p.allFinite()) continue;
+    const VoxelIndex index = index_of(p);
+    GaussianVoxel& v = voxels_[index];
+    const Eigen::Vector3d local =
+        p - Eigen::Vector3d(index.x, index.y, index.z) * options_.voxel_size;
+    if (v.pending == 0) touched.push_back(index);
+    ++v.pending;
+    v.pending_sum += local;
+    v.pending_outer += local * local.transpose();
+  }
+  std::size_t merged = 0;
+  for (const VoxelIndex& index : touched) {
+    GaussianVoxel& v = voxels_[index];
+    if (v.pending >= options_.merge_threshold) {
+      merge_pending(index, v);
+      ++merged;
+    }
+  }
+  return merged;
+}
+
+void GaussianVoxelMap::flush() {
+  for (auto& [index, voxel] : voxels_) merge_pending(index, voxel);
+}
+
+std::size_t GaussianVoxelMap::remove_far(const Eigen::Vector3d& center, double radius) {
+  const double r2 = radius * radius;
+  std::size_t removed = 0;
+  for (auto it = voxels_.begin(); it != voxels_.end();) {
+    const Eigen::Vector3d where = it->second.count > 0
+                                      ? it->second.mean
+                                      : (Eigen::Vector3d(it->first.x, it->first.y, it->first.z) +
+                                         Eigen::Vector3d::Constant(0.5)) *
+                                            options_.voxel_size;
+    if ((where - center).squaredNorm() > r2) {
+      it = voxels_.erase(it);
+      ++removed;
+    } else {
+      ++it;
+    }
+  }
+  return removed;
+}
+
+}  // namespace scanmatch

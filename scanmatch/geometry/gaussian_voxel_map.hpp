@@ -1,0 +1,97 @@
+#pragma once
+// The one voxel map of Gaussians (count, mean, covariance per voxel, addressed by a hash of the
+// integer voxel coordinate). It serves NDT, VGICP and the CTF-ICP fine stage, and is the CTF-ICP
+// global map: points accumulate per voxel and are merged into its Gaussian only once
+// `merge_threshold` new points are pending (METHODS.md section 1 step 4).
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "scanmatch/core/point_cloud.hpp"
+#include "scanmatch/core/se3.hpp"
+
+namespace scanmatch {
+
+struct VoxelIndex {
+  std::int32_t x = 0, y = 0, z = 0;
+  bool operator==(const VoxelIndex&) const = default;
+};
+struct VoxelIndexHash {
+  std::size_t operator()(const VoxelIndex& v) const {
+    return (static_cast<std::size_t>(v.x) * 73856093u) ^
+           (static_cast<std::size_t>(v.y) * 19349669u) ^
+           (static_cast<std::size_t>(v.z) * 83492791u);
+  }
+};
+
+struct GaussianVoxel {
+  std::uint32_t count = 0;  ///< points merged into the Gaussian
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< population covariance
+  /// Cached from the covariance after each merge:
+  Eigen::Matrix3d planar_information = Eigen::Matrix3d::Identity();  ///< (Q diag(1,1,eps) Q^T)^-1
+  Eigen::Matrix3d regularized_covariance =
+      Eigen::Matrix3d::Identity();  ///< eigenvalues >= 1e-3 max
+  Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
+  /// Points waiting to be merged (sums relative to the voxel's corner for precision).
+  std::uint32_t pending = 0;
+  Eigen::Vector3d pending_sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d pending_outer = Eigen::Matrix3d::Zero();
+};
+
+struct GaussianVoxelMapOptions {
+  double voxel_size = 1.0;            ///< m
+  std::uint32_t merge_threshold = 1;  ///< pending points needed before a merge (CTF-ICP: 5)
+  std::uint32_t min_points = 5;       ///< a voxel is used for registration from this many points
+  double planar_epsilon = 1e-6;       ///< smallest eigenvalue of the planar covariance (CTF: 1e-6)
+};
+
+class GaussianVoxelMap {
+ public:
+  explicit GaussianVoxelMap(const GaussianVoxelMapOptions& options = {});
+
+  /// Adds the cloud's points moved by `pose`; merges every voxel whose pending points reached the
+  /// threshold. Returns the number of voxels merged.
+  std::size_t insert(const PointCloud& cloud, const Pose& pose = Pose::Identity());
+  /// Merges every voxel's pending points regardless of the threshold.
+  void flush();
+  /// Drops voxels whose mean is farther than `radius` from `center` (bounded map memory).
+  std::size_t remove_far(const Eigen::Vector3d& center, double radius);
+
+  VoxelIndex index_of(const Eigen::Vector3d& p) const;
+  /// The usable voxel (count >= min_points) containing p, or nullptr.
+  const GaussianVoxel* find(const Eigen::Vector3d& p) const;
+  /// Calls f(voxel) for the usable voxels among p's voxel and its 6 (neighbours = 7) or 26
+  /// (neighbours = 27) neighbours; neighbours = 1 is p's voxel only.
+  template <typename F>
+  void for_each_neighbour(const Eigen::Vector3d& p, int neighbours, F&& f) const {
+    const VoxelIndex c = index_of(p);
+    for (const auto& o : offsets(neighbours)) {
+      const auto it = voxels_.find(VoxelIndex{c.x + o[0], c.y + o[1], c.z + o[2]});
+      if (it != voxels_.end() && it->second.count >= options_.min_points) f(it->second);
+    }
+  }
+
+  std::size_t size() const { return voxels_.size(); }
+  const GaussianVoxelMapOptions& options() const { return options_; }
+  const std::unordered_map<VoxelIndex, GaussianVoxel, VoxelIndexHash>& voxels() const {
+    return voxels_;
+  }
+
+  /// The merge of METHODS.md: (m, mu1, C1) + (n, mu2, C2) with the outer-product cross term.
+  static void merge(GaussianVoxel& voxel, std::uint32_t n, const Eigen::Vector3d& mean,
+                    const Eigen::Matrix3d& covariance);
+
+ private:
+  static const std::vector<std::array<int, 3>>& offsets(int neighbours);
+  void merge_pending(const VoxelIndex& index, GaussianVoxel& voxel);
+  void update_cache(GaussianVoxel& voxel) const;
+  GaussianVoxelMapOptions options_;
+  std::unordered_map<VoxelIndex, GaussianVoxel, VoxelIndexHash> voxels_;
+};
+
+}  // namespace scanmatch

@@ -1,0 +1,224 @@
+#pragma once
+// The one Gauss-Newton / Levenberg-Marquardt solver on SE(3) that every registration method uses.
+//
+// Perturbation: right (body frame), T <- T * exp(delta), delta = [rotation; translation], the
+// tangent order of core/se3.hpp. For a transformed point T p the Jacobian is [-R [p]x, R].
+//
+// A method is a Factor: an object with
+//   std::size_t size() const;                                  // number of source elements
+//   bool linearize(const Pose& T, std::size_t i, LinearSystem& system, const RobustKernel& kernel)
+//   const;
+// which finds element i's correspondence under T and adds its residual through
+// LinearSystem::add (returning false when it has none). The solver owns everything else.
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "scanmatch/core/se3.hpp"
+
+namespace scanmatch {
+
+enum class KernelType { kNone, kHuber, kCauchy, kTukey, kGemanMcClure };
+/// "none", "huber", "cauchy", "tukey", "geman-mcclure"; throws Error.
+KernelType parse_kernel(const std::string& name);
+
+/// Robust kernel on the squared (Mahalanobis) residual s = r^T W r, as an IRLS weight.
+struct RobustKernel {
+  KernelType type = KernelType::kNone;
+  double scale = 1.0;  ///< residual size (m) where the kernel starts to down-weight
+
+  double weight(double s) const {
+    const double c2 = scale * scale;
+    switch (type) {
+      case KernelType::kNone:
+        return 1.0;
+      case KernelType::kHuber:
+        return s <= c2 ? 1.0 : scale / std::sqrt(s);
+      case KernelType::kCauchy:
+        return 1.0 / (1.0 + s / c2);
+      case KernelType::kTukey: {
+        if (s >= c2) return 0.0;
+        const double u = 1.0 - s / c2;
+        return u * u;
+      }
+      case KernelType::kGemanMcClure: {
+        const double d = c2 + s;
+        return c2 * c2 / (d * d);
+      }
+    }
+    return 1.0;
+  }
+  /// The robust cost rho(s) whose IRLS weight is weight(s) (rho(s) ~ s for small s).
+  double cost(double s) const {
+    const double c2 = scale * scale;
+    switch (type) {
+      case KernelType::kNone:
+        return s;
+      case KernelType::kHuber:
+        return s <= c2 ? s : 2.0 * scale * std::sqrt(s) - c2;
+      case KernelType::kCauchy:
+        return c2 * std::log1p(s / c2);
+      case KernelType::kTukey: {
+        if (s >= c2) return c2 / 3.0;
+        const double u = 1.0 - s / c2;
+        return c2 / 3.0 * (1.0 - u * u * u);
+      }
+      case KernelType::kGemanMcClure:
+        return c2 * s / (c2 + s);
+    }
+    return s;
+  }
+};
+
+/// Normal equations H delta = -b accumulated over correspondences.
+struct LinearSystem {
+  Matrix6d H = Matrix6d::Zero();
+  Vector6d b = Vector6d::Zero();
+  double cost = 0.0;
+  std::size_t inliers = 0;
+  double squared_error = 0.0;  ///< sum of plain squared residual norms (for fitness)
+
+  /// Adds residual r (D rows) with Jacobian J (D x 6) and information W (D x D).
+  template <int D>
+  void add(const Eigen::Matrix<double, D, 6>& J, const Eigen::Matrix<double, D, 1>& r,
+           const Eigen::Matrix<double, D, D>& W, const RobustKernel& kernel) {
+    const double s = r.dot(W * r);
+    const double w = kernel.weight(s);
+    const Eigen::Matrix<double, 6, D> JtW = J.transpose() * (w * W);
+    H.noalias() += JtW * J;
+    b.noalias() += JtW * r;
+    cost += kernel.cost(s);
+    squared_error += r.squaredNorm();
+    ++inliers;
+  }
+  /// Weighted form for methods that compute their own weight (NDT's score).
+  template <int D>
+  void add_weighted(const Eigen::Matrix<double, D, 6>& J, const Eigen::Matrix<double, D, 1>& r,
+                    const Eigen::Matrix<double, D, D>& W, double weight, double cost_term) {
+    const Eigen::Matrix<double, 6, D> JtW = J.transpose() * (weight * W);
+    H.noalias() += JtW * J;
+    b.noalias() += JtW * r;
+    cost += cost_term;
+    squared_error += r.squaredNorm();
+    ++inliers;
+  }
+  void operator+=(const LinearSystem& o) {
+    H += o.H;
+    b += o.b;
+    cost += o.cost;
+    inliers += o.inliers;
+    squared_error += o.squared_error;
+  }
+};
+
+/// Jacobian of T p with respect to the right perturbation (tangent order [rotation; translation]).
+inline Eigen::Matrix<double, 3, 6> point_jacobian(const Pose& T, const Eigen::Vector3d& p) {
+  Eigen::Matrix<double, 3, 6> J;
+  J.leftCols<3>() = -T.linear() * skew(p);
+  J.rightCols<3>() = T.linear();
+  return J;
+}
+
+struct SolverOptions {
+  int max_iterations = 30;
+  double rotation_tolerance = 1e-5;       ///< rad: converged when the update is smaller ...
+  double translation_tolerance = 1e-5;    ///< m: ... in both rotation and translation,
+  double relative_cost_tolerance = 1e-9;  ///< or the cost changes relatively less than this
+  bool levenberg_marquardt = false;       ///< LM damping (accepts only cost-decreasing steps)
+  double initial_lambda = 1e-6;
+  RobustKernel kernel;
+  int num_threads = 1;  ///< 1: single-threaded reduction; > 1: TBB with that many threads
+};
+
+struct RegistrationResult {
+  Pose transform = Pose::Identity();  ///< maps source coordinates into the target frame
+  int iterations = 0;
+  double cost = 0.0;  ///< final robust cost
+  std::size_t inliers = 0;
+  double fitness = 0.0;  ///< mean squared residual norm of the inliers, m^2
+  bool converged = false;
+  std::string stop_reason;
+  Matrix6d information = Matrix6d::Zero();  ///< H at the solution
+  Vector6d eigenvalues = Vector6d::Zero();  ///< of the information, ascending
+  double condition_number = 0.0;            ///< largest / smallest eigenvalue (inf if singular)
+  std::string summary() const;
+};
+
+/// Linearises every element at T (one thread or TBB), returning the summed system.
+LinearSystem reduce_parallel(
+    std::size_t n, int num_threads,
+    const std::function<void(std::size_t, std::size_t, LinearSystem&)>& block);
+
+template <typename Factor>
+LinearSystem linearize_all(const Factor& factor, const Pose& T, const SolverOptions& options) {
+  const auto block = [&](std::size_t begin, std::size_t end, LinearSystem& system) {
+    for (std::size_t i = begin; i < end; ++i) factor.linearize(T, i, system, options.kernel);
+  };
+  if (options.num_threads <= 1) {
+    LinearSystem system;
+    block(0, factor.size(), system);
+    return system;
+  }
+  return reduce_parallel(factor.size(), options.num_threads, block);
+}
+
+void finish_result(RegistrationResult& result, const LinearSystem& system);
+
+/// Minimises the factor's cost over T starting from `initial`.
+template <typename Factor>
+RegistrationResult optimize(const Factor& factor, const Pose& initial,
+                            const SolverOptions& options) {
+  RegistrationResult result;
+  Pose T = initial;
+  double lambda = options.initial_lambda;
+  LinearSystem system = linearize_all(factor, T, options);
+  result.stop_reason = "iteration limit";
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    result.iterations = iteration + 1;
+    if (system.inliers < 6) {
+      result.stop_reason = "too few correspondences (" + std::to_string(system.inliers) + ")";
+      break;
+    }
+    Matrix6d H = system.H;
+    if (options.levenberg_marquardt) H.diagonal() += lambda * (Vector6d::Ones() + H.diagonal());
+    const Vector6d delta = H.ldlt().solve(-system.b);
+    if (!delta.allFinite()) {
+      result.stop_reason = "singular system";
+      break;
+    }
+    const Pose candidate = T * se3_exp(delta);
+    LinearSystem next = linearize_all(factor, candidate, options);
+    if (options.levenberg_marquardt && next.cost > system.cost && next.inliers >= system.inliers) {
+      lambda *= 10.0;  // reject the step, damp more
+      if (lambda > 1e6) {
+        result.stop_reason = "no decreasing step";
+        break;
+      }
+      continue;
+    }
+    if (options.levenberg_marquardt) lambda = std::max(lambda / 10.0, 1e-12);
+    const double previous_cost = system.cost;
+    T = candidate;
+    system = std::move(next);
+    if (delta.head<3>().norm() < options.rotation_tolerance &&
+        delta.tail<3>().norm() < options.translation_tolerance) {
+      result.converged = true;
+      result.stop_reason = "update below tolerance";
+      break;
+    }
+    if (std::abs(previous_cost - system.cost) <=
+        options.relative_cost_tolerance * std::max(std::abs(previous_cost), 1e-30)) {
+      result.converged = true;
+      result.stop_reason = "cost change below tolerance";
+      break;
+    }
+  }
+  result.transform = T;
+  finish_result(result, system);
+  return result;
+}
+
+}  // namespace scanmatch
