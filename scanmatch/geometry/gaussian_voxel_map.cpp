@@ -83,6 +83,7 @@ void GaussianVoxelMap::merge_pending(const VoxelIndex& index, GaussianVoxel& v) 
 std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) {
   std::vector<VoxelIndex> touched;
   touched.reserve(cloud.size() / 4 + 1);
+  const std::uint64_t call = ++insert_calls_;
   for (const Point& point : cloud.points) {
     const Eigen::Vector3d p = pose * point.cast<double>();
     if (!p.allFinite()) continue;
@@ -90,7 +91,10 @@ std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) 
     GaussianVoxel& v = voxels_[index];
     const Eigen::Vector3d local =
         p - Eigen::Vector3d(index.x, index.y, index.z) * options_.voxel_size;
-    if (v.pending == 0) touched.push_back(index);
+    if (v.last_insert != call) {
+      v.last_insert = call;
+      touched.push_back(index);
+    }
     ++v.pending;
     v.pending_sum += local;
     v.pending_outer += local * local.transpose();

@@ -39,6 +39,7 @@ struct GaussianVoxel {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
   /// Points waiting to be merged (sums relative to the voxel's corner for precision).
   std::uint32_t pending = 0;
+  std::uint64_t last_insert = 0;  ///< which insert() call last touched the voxel
   Eigen::Vector3d pending_sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d pending_outer = Eigen::Matrix3d::Zero();
 };
@@ -91,6 +92,7 @@ class GaussianVoxelMap {
   void merge_pending(const VoxelIndex& index, GaussianVoxel& voxel);
   void update_cache(GaussianVoxel& voxel) const;
   GaussianVoxelMapOptions options_;
+  std::uint64_t insert_calls_ = 0;
   std::unordered_map<VoxelIndex, GaussianVoxel, VoxelIndexHash> voxels_;
 };
 

@@ -1,0 +1,310 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <optional>
+#include <random>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/covariance.hpp"
+#include "scanmatch/geometry/gaussian_voxel_map.hpp"
+#include "scanmatch/geometry/kdtree.hpp"
+#include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/io/cloud_io.hpp"
+#include "scanmatch/registration/factors.hpp"
+#include "scanmatch/registration/methods.hpp"
+#include "scanmatch/sim/simulator.hpp"
+#include "test_helpers.hpp"
+
+using namespace scanmatch;
+
+namespace {
+double degrees(double rad) {
+  return rad * 180.0 / M_PI;
+}
+
+struct Pair {
+  PointCloud source, target;
+  Pose truth;                         // T_target_source
+  Pose guess = Pose::Identity();      // constant-velocity guess: the previous frame's motion
+};
+
+// Consecutive frames of a simulated moving sensor (no motion distortion: the registration, not
+// deskewing, is under test), downsampled like an odometry front end does.
+Pair simulated_pair(const std::string& preset, const std::string& sensor, std::size_t frame) {
+  sim::SimOptions o;
+  o.preset = preset;
+  o.sensor = sensor;
+  o.frames = frame + 2;
+  o.motion_distortion = false;
+  const sim::Simulator s(o);
+  return {voxel_downsample(s.frame(frame + 1), 0.25), voxel_downsample(s.frame(frame), 0.25),
+          s.pose(frame).inverse() * s.pose(frame + 1),
+          frame > 0 ? s.pose(frame - 1).inverse() * s.pose(frame) : Pose::Identity()};
+}
+
+void expect_recovers(const Pair& pair, const std::string& method, double metres, double deg,
+                     std::optional<Pose> initial = std::nullopt) {
+  RegistrationOptions o;
+  o.method = method;
+  o.solver.max_iterations = 60;
+  const RegistrationResult r = register_clouds(pair.source, pair.target, o, initial.value_or(pair.guess));
+  const Pose error = pair.truth.inverse() * r.transform;
+  EXPECT_LT(error.translation().norm(), metres) << method << ": " << r.summary();
+  EXPECT_LT(degrees(rotation_angle(error)), deg) << method << ": " << r.summary();
+}
+}  // namespace
+
+TEST(RobustKernel, WeightsAndCosts) {
+  RobustKernel k;
+  EXPECT_DOUBLE_EQ(k.weight(100.0), 1.0);
+  k.scale = 0.5;
+  k.type = KernelType::kHuber;
+  EXPECT_DOUBLE_EQ(k.weight(0.1), 1.0);
+  EXPECT_DOUBLE_EQ(k.weight(1.0), 0.5);  // c / |r| beyond the threshold
+  k.type = KernelType::kCauchy;
+  EXPECT_DOUBLE_EQ(k.weight(0.25), 0.5);
+  k.type = KernelType::kTukey;
+  EXPECT_DOUBLE_EQ(k.weight(0.25), 0.0);
+  EXPECT_DOUBLE_EQ(k.weight(0.0), 1.0);
+  k.type = KernelType::kGemanMcClure;
+  EXPECT_DOUBLE_EQ(k.weight(0.25), 0.25);
+  // The weight is rho'(s): check by finite differences for every kernel.
+  for (auto type :
+       {KernelType::kHuber, KernelType::kCauchy, KernelType::kTukey, KernelType::kGemanMcClure}) {
+    k.type = type;
+    for (double s : {0.01, 0.2, 0.6})
+      EXPECT_NEAR((k.cost(s + 1e-7) - k.cost(s - 1e-7)) / 2e-7, k.weight(s), 1e-5);
+  }
+  EXPECT_THROW(parse_kernel("l1"), Error);
+}
+
+TEST(Solver, PointJacobianMatchesNumericalDerivative) {
+  const Pose T = from_xyz_rpy(0.3, -1.0, 2.0, 0.2, -0.4, 1.1);
+  const Eigen::Vector3d p(1.5, -0.7, 2.2);
+  const Eigen::Matrix<double, 3, 6> J = point_jacobian(T, p);
+  for (int k = 0; k < 6; ++k) {
+    Vector6d d = Vector6d::Zero();
+    d(k) = 1e-6;
+    const Eigen::Vector3d numeric = ((T * se3_exp(d)) * p - (T * se3_exp(-d)) * p) / 2e-6;
+    EXPECT_LT((numeric - J.col(k)).norm(), 1e-6) << "column " << k;
+  }
+}
+
+TEST(Solver, ExactCorrespondencesConvergeImmediately) {
+  // Point-to-point with exact correspondences and a small motion: Gauss-Newton lands on the truth.
+  PointCloud target;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-5, 5);
+  for (int i = 0; i < 300; ++i) target.points.emplace_back(u(rng), u(rng), u(rng));
+  const Pose truth = from_xyz_rpy(0.05, -0.03, 0.02, 0.01, 0.02, -0.015);
+  PointCloud source;
+  for (const Point& q : target.points)
+    source.points.push_back((truth.inverse() * q.cast<double>()).cast<float>());
+  struct Exact {
+    const PointCloud& s;
+    const PointCloud& t;
+    std::size_t size() const { return s.size(); }
+    bool linearize(const Pose& T, std::size_t i, LinearSystem& sys, const RobustKernel& k) const {
+      const Eigen::Vector3d p = s.points[i].cast<double>();
+      sys.add<3>(point_jacobian(T, p), T * p - t.points[i].cast<double>(),
+                 Eigen::Matrix3d::Identity(), k);
+      return true;
+    }
+  };
+  const RegistrationResult r = optimize(Exact{source, target}, Pose::Identity(), SolverOptions{});
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(r.iterations, 4);
+  EXPECT_TRUE(r.transform.isApprox(truth, 1e-6));
+}
+
+TEST(Solver, CorridorInformationIsDegenerateAlongItsAxis) {
+  // Two parallel walls and a floor along x: nothing constrains translation along x. (Walls and
+  // floor do not touch: an L-shaped neighbourhood would give a normal along x.)
+  PointCloud corridor;
+  for (int i = 0; i <= 200; ++i) {
+    const float x = -10.0f + 0.1f * static_cast<float>(i);
+    for (int k = 0; k <= 20; ++k) {
+      const float h = 0.1f * static_cast<float>(k);
+      corridor.points.emplace_back(x, -1.25f, 0.5f + h);
+      corridor.points.emplace_back(x, 1.25f, 0.5f + h);
+      corridor.points.emplace_back(x, -1.0f + h, 0.0f);
+    }
+  }
+  RegistrationOptions o;
+  o.method = "point-to-plane";
+  const RegistrationResult r = register_clouds(corridor, corridor, o);
+  Eigen::SelfAdjointEigenSolver<Matrix6d> solver(r.information);
+  const Vector6d weakest = solver.eigenvectors().col(0);
+  EXPECT_GT(std::abs(weakest(3)), 0.99);  // the translation-x direction
+  // Closing the corridor with an end wall removes the degeneracy.
+  PointCloud closed = corridor;
+  for (int j = 0; j <= 20; ++j)
+    for (int k = 0; k <= 20; ++k) closed.points.emplace_back(10.5f, -1.0f + 0.1f * j, 0.5f + 0.1f * k);
+  const RegistrationResult c = register_clouds(closed, closed, o);
+  EXPECT_GT(r.condition_number, 1e8);
+  EXPECT_LT(c.condition_number, 1e5);
+}
+
+TEST(Geometry, KdTreeMatchesBruteForce) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-10, 10);
+  PointCloud cloud;
+  for (int i = 0; i < 2000; ++i) cloud.points.emplace_back(u(rng), u(rng), u(rng));
+  const KdTree tree(cloud.points);
+  for (int q = 0; q < 100; ++q) {
+    const Point query(u(rng), u(rng), u(rng));
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < cloud.size(); ++i)
+      if ((cloud.points[i] - query).squaredNorm() < (cloud.points[best] - query).squaredNorm())
+        best = i;
+    std::size_t index;
+    float d2;
+    ASSERT_TRUE(tree.nearest(query, 1e9f, index, d2));
+    EXPECT_EQ(index, best);
+    std::size_t indices[5];
+    float distances[5];
+    EXPECT_EQ(tree.knn(query, 5, indices, distances), 5u);
+    EXPECT_EQ(indices[0], best);
+    for (int k = 1; k < 5; ++k) EXPECT_LE(distances[k - 1], distances[k]);
+  }
+  std::size_t index;
+  float d2;
+  EXPECT_FALSE(tree.nearest(Point(100, 100, 100), 1.0f, index, d2));
+}
+
+TEST(Geometry, GaussianMapMergeEqualsBatchStatistics) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 0.1);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 50; ++i)
+    points.emplace_back(0.5 + n(rng), 0.5 + 0.5 * n(rng), 0.5 + 0.2 * n(rng));
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += p;
+  mean /= 50.0;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) cov += (p - mean) * (p - mean).transpose();
+  cov /= 50.0;
+  // Insert in three batches of different sizes with the CTF rule (merge from 5 pending points).
+  GaussianVoxelMapOptions options;
+  options.voxel_size = 10.0;
+  options.merge_threshold = 5;
+  GaussianVoxelMap map(options);
+  const auto batch = [&](int from, int to) {
+    PointCloud c;
+    for (int i = from; i < to; ++i)
+      c.points.push_back(points[static_cast<std::size_t>(i)].cast<float>());
+    return c;
+  };
+  EXPECT_EQ(map.insert(batch(0, 3)), 0u);  // 3 pending: below the 5-point rule, nothing merged
+  EXPECT_EQ(map.find({0.5, 0.5, 0.5}), nullptr);
+  EXPECT_EQ(map.insert(batch(3, 20)), 1u);
+  EXPECT_EQ(map.insert(batch(20, 50)), 1u);
+  const GaussianVoxel* v = map.find({0.5, 0.5, 0.5});
+  ASSERT_NE(v, nullptr);
+  EXPECT_EQ(v->count, 50u);
+  EXPECT_LT((v->mean - mean).norm(), 1e-6);
+  EXPECT_LT((v->covariance - cov).norm(), 1e-6);
+  // The planar information has the smallest eigenvector as its stiff direction.
+  const Eigen::Vector3d normal = v->normal;
+  EXPECT_NEAR(normal.dot(v->planar_information * normal), 1e6, 1.0);
+  EXPECT_EQ(map.remove_far(Eigen::Vector3d(100, 0, 0), 10.0), 1u);
+  EXPECT_EQ(map.size(), 0u);
+}
+
+TEST(Registration, EveryMethodRecoversSimulatedMotion) {
+  // Plane-based methods: 2 cm and 0.1 deg on consecutive frames (sensor noise is 2-3 cm per point,
+  // averaged over thousands of points). Point-based methods (icp, point-to-line) match points that
+  // are not the same surface samples (0.25 m voxel centroids of different scans), so they keep a
+  // bias of up to a third of the voxel size at car speed: 12 cm and 0.6 deg.
+  const Pair pairs[] = {simulated_pair("dynamic-indoor", "mid360", 30),
+                        simulated_pair("campus-os1", "os1-64", 40),
+                        simulated_pair("urban-hdl64", "hdl64", 20)};
+  for (const Pair& pair : pairs) {
+    for (const char* m : {"point-to-plane", "gicp", "vgicp", "ndt", "ctf-fine"})
+      expect_recovers(pair, m, 0.02, 0.1);
+    for (const char* m : {"icp", "icp-gn", "point-to-line"}) expect_recovers(pair, m, 0.12, 0.6);
+  }
+}
+
+TEST(Registration, BruteForceIcpEqualsKdTreeIcp) {
+  const Pair pair = simulated_pair("dynamic-indoor", "mid360", 10);
+  Pair small{voxel_downsample(pair.source, 0.6), voxel_downsample(pair.target, 0.6), pair.truth};
+  RegistrationOptions o;
+  o.method = "icp-brute";
+  const RegistrationResult brute = register_clouds(small.source, small.target, o);
+  o.method = "icp-kdtree";
+  const RegistrationResult tree = register_clouds(small.source, small.target, o);
+  EXPECT_EQ(brute.iterations, tree.iterations);
+  EXPECT_TRUE(brute.transform.isApprox(tree.transform, 1e-9));
+}
+
+TEST(Registration, ThreadedEqualsSingleThreaded) {
+  const Pair pair = simulated_pair("dynamic-outdoor", "mid360", 5);
+  RegistrationOptions o;
+  o.method = "gicp";
+  const RegistrationResult one = register_clouds(pair.source, pair.target, o);
+  o.solver.num_threads = 2;
+  const RegistrationResult two = register_clouds(pair.source, pair.target, o);
+  EXPECT_LT((one.transform.translation() - two.transform.translation()).norm(), 1e-6);
+}
+
+TEST(Registration, RecoversFromAnOffsetInitialGuess) {
+  const Pair pair = simulated_pair("dynamic-outdoor", "mid360", 50);
+  const Pose initial = pair.truth * from_xyz_rpy(0.3, -0.2, 0.05, 0.01, -0.01, 0.05);
+  for (const char* m : {"gicp", "vgicp", "ndt", "ctf-fine", "point-to-plane"})
+    expect_recovers(pair, m, 0.02, 0.1, initial);
+}
+
+TEST(Registration, BadInputGivesClearErrors) {
+  PointCloud few;
+  few.points = {Point(0, 0, 0), Point(1, 0, 0)};
+  const Pair pair = simulated_pair("dynamic-indoor", "mid360", 1);
+  RegistrationOptions o;
+  o.method = "gicp";
+  EXPECT_THROW(register_clouds(few, pair.target, o), Error);
+  o.method = "magic";
+  EXPECT_THROW(register_clouds(pair.source, pair.target, o), Error);
+  o.method = "icp";
+  Pose bad = Pose::Identity();
+  bad.translation().x() = std::nan("");
+  EXPECT_THROW(register_clouds(pair.source, pair.target, o, bad), Error);
+}
+
+TEST(Registration, RealHdl32PairWithinFiveCentimetresAndHalfADegree) {
+  const std::string folder = scanmatch::testing::shared_data("data/3d/hdl32_pair");
+  if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/hdl32_pair not present";
+  const PointCloud source = voxel_downsample(read_cloud(folder + "/source.ply"), 0.1);
+  const PointCloud target = voxel_downsample(read_cloud(folder + "/target.ply"), 0.1);
+  Eigen::Matrix4d M;
+  std::ifstream in(folder + "/T_target_source.txt");
+  for (int i = 0; i < 16; ++i) in >> M(i / 4, i % 4);
+  const Pair pair{source, target, from_matrix(M)};
+  for (const char* m : {"point-to-plane", "gicp", "vgicp", "ndt", "ctf-fine"})
+    expect_recovers(pair, m, 0.05, 0.5);
+}
+
+TEST(Cli, RegisterPrintsTransformAndRejectsBadInput) {
+  scanmatch::testing::TempDir dir;
+  const Pair pair = simulated_pair("dynamic-indoor", "mid360", 3);
+  write_cloud(dir.file("s.pcd"), pair.source);
+  write_cloud(dir.file("t.pcd"), pair.target);
+  const auto ok = scanmatch::testing::run_cli("register " + dir.file("s.pcd") + " " +
+                                              dir.file("t.pcd") + " --method ctf-fine --json");
+  ASSERT_EQ(ok.status, 0) << ok.output;
+  EXPECT_NE(ok.output.find("\"transform\""), std::string::npos);
+  EXPECT_NE(ok.output.find("\"condition_number\""), std::string::npos);
+  EXPECT_NE(
+      scanmatch::testing::run_cli("register " + dir.file("s.pcd") + " " + dir.file("missing.pcd"))
+          .status,
+      0);
+  EXPECT_NE(scanmatch::testing::run_cli("register " + dir.file("s.pcd") + " " + dir.file("t.pcd") +
+                                        " --init 1,2,3")
+                .status,
+            0);
+  PointCloud empty;
+  write_cloud(dir.file("e.pcd"), empty);
+  const auto e =
+      scanmatch::testing::run_cli("register " + dir.file("e.pcd") + " " + dir.file("t.pcd"));
+  EXPECT_NE(e.status, 0);
+  EXPECT_NE(e.output.find("empty"), std::string::npos);
+}
