@@ -8,6 +8,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/covariance.hpp"
 #include "scanmatch/registration/factors.hpp"
+#include "scanmatch/registration/loam.hpp"
 
 namespace scanmatch {
 
@@ -107,8 +108,8 @@ Eigen::Matrix3d floored_covariance(const Eigen::Matrix3d& C) {
 }  // namespace
 
 std::vector<std::string> registration_method_names() {
-  return {"icp",           "icp-kdtree", "icp-brute", "icp-gn", "point-to-plane",
-          "point-to-line", "gicp",       "vgicp",     "ndt",    "ctf-fine"};
+  return {"icp",   "icp-kdtree", "icp-brute", "icp-gn", "point-to-plane", "point-to-line", "gicp",
+          "vgicp", "ndt",        "ctf-fine",  "loam",   "loam-edge",      "loam-plane"};
 }
 
 std::size_t minimum_points(const std::string& method, const RegistrationOptions& o) {
@@ -116,6 +117,8 @@ std::size_t minimum_points(const std::string& method, const RegistrationOptions&
   if (method == "gicp" || method == "vgicp")
     return static_cast<std::size_t>(std::max(o.covariance_neighbours, 6));
   if (method == "ndt" || method == "ctf-fine") return 10;
+  if (method.rfind("loam", 0) == 0)
+    return static_cast<std::size_t>(2 * o.loam.neighbours + 1 + o.loam.segments);
   return 6;
 }
 
@@ -143,6 +146,10 @@ RegistrationResult register_clouds(const PointCloud& source, const PointCloud& t
     return m == "icp-gn" ? optimize(factor, initial, o.solver)
                          : icp_closed_form(factor, initial, o.solver);
   }
+  if (m == "loam") return register_loam(source, target, LoamResiduals::kBoth, o, initial);
+  if (m == "loam-edge") return register_loam(source, target, LoamResiduals::kEdgesOnly, o, initial);
+  if (m == "loam-plane")
+    return register_loam(source, target, LoamResiduals::kPlanesOnly, o, initial);
   if (m == "point-to-plane") {
     const KdTree tree(target.points);
     const auto normals = estimate_normals(target, tree, o.normal_neighbours, o.solver.num_threads);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
+#include "scanmatch/features/loam_features.hpp"
 #include "scanmatch/registration/solver.hpp"
 
 namespace scanmatch {
@@ -13,7 +14,7 @@ namespace scanmatch {
 struct RegistrationOptions {
   /// icp (SVD step, k-d tree), icp-kdtree (same), icp-brute (SVD step, exhaustive search),
   /// icp-gn (point-to-point on the Gauss-Newton solver), point-to-plane, point-to-line, gicp,
-  /// vgicp, ndt, ctf-fine.
+  /// vgicp, ndt, ctf-fine, loam (edge and planar features), loam-edge, loam-plane.
   std::string method = "gicp";
   double max_correspondence_distance = 1.0;  ///< m, point-based methods
   int normal_neighbours = 10;                ///< k for normals (point-to-plane)
@@ -24,6 +25,7 @@ struct RegistrationOptions {
                                     ///< (ndt 7, vgicp 1, ctf-fine 1)
   double ndt_outlier_ratio = 0.55;  ///< Magnusson's outlier probability for the score constants
   double ctf_epsilon = 1e-6;        ///< CTF-ICP's normalised smallest eigenvalue
+  LoamFeatureOptions loam;          ///< feature extraction of the loam methods
   SolverOptions solver;
 };
 
