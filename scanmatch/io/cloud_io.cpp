@@ -137,26 +137,7 @@ std::string format_text(const PointCloud& cloud, bool csv) {
     out += "t";
   }
   out += '\n';
-  char buffer[160];
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Point& p = cloud.points[i];
-    int len =
-        std::snprintf(buffer, sizeof buffer, "%.9g%s%.9g%s%.9g", p.x(), sep, p.y(), sep, p.z());
-    out.append(buffer, static_cast<std::size_t>(len));
-    if (cloud.has_intensity()) {
-      len = std::snprintf(buffer, sizeof buffer, "%s%.9g", sep, cloud.intensity[i]);
-      out.append(buffer, static_cast<std::size_t>(len));
-    }
-    if (cloud.has_ring()) {
-      out += sep;
-      out += std::to_string(cloud.ring[i]);
-    }
-    if (cloud.has_time()) {
-      len = std::snprintf(buffer, sizeof buffer, "%s%.9g", sep, cloud.time[i]);
-      out.append(buffer, static_cast<std::size_t>(len));
-    }
-    out += '\n';
-  }
+  for (std::size_t i = 0; i < cloud.size(); ++i) append_point_text(out, cloud, i, csv ? ',' : ' ');
   return out;
 }
 

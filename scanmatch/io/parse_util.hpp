@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <string_view>
@@ -202,6 +203,39 @@ inline double load_as_double(const char* p, ScalarType type, bool big_endian) {
 
 inline void append_bytes(std::string& out, const void* p, std::size_t n) {
   out.append(static_cast<const char*>(p), n);
+}
+
+/// Appends point i as text: x y z and whichever optional fields the cloud has, `separator` between
+/// values, 9 significant digits (floats round-trip exactly), and a newline.
+inline void append_point_text(std::string& out, const PointCloud& cloud, std::size_t i,
+                              char separator) {
+  char buffer[160];
+  const Point& p = cloud.points[i];
+  int len = std::snprintf(buffer, sizeof buffer, "%.9g%c%.9g%c%.9g", p.x(), separator, p.y(),
+                          separator, p.z());
+  out.append(buffer, static_cast<std::size_t>(len));
+  if (cloud.has_intensity()) {
+    len = std::snprintf(buffer, sizeof buffer, "%c%.9g", separator, cloud.intensity[i]);
+    out.append(buffer, static_cast<std::size_t>(len));
+  }
+  if (cloud.has_ring()) {
+    out += separator;
+    out += std::to_string(cloud.ring[i]);
+  }
+  if (cloud.has_time()) {
+    len = std::snprintf(buffer, sizeof buffer, "%c%.9g", separator, cloud.time[i]);
+    out.append(buffer, static_cast<std::size_t>(len));
+  }
+  out += '\n';
+}
+
+/// Appends point i as a little-endian record: float x y z, then the optional float intensity,
+/// uint16 ring and float time that the cloud has (the layout both PCD and PLY writers declare).
+inline void append_point_binary(std::string& out, const PointCloud& cloud, std::size_t i) {
+  append_bytes(out, cloud.points[i].data(), 12);
+  if (cloud.has_intensity()) append_bytes(out, &cloud.intensity[i], 4);
+  if (cloud.has_ring()) append_bytes(out, &cloud.ring[i], 2);
+  if (cloud.has_time()) append_bytes(out, &cloud.time[i], 4);
 }
 
 }  // namespace scanmatch::io_detail

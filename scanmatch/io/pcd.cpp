@@ -286,25 +286,7 @@ std::string format_pcd(const PointCloud& cloud, CloudWriteOptions::Encoding enco
   using Encoding = CloudWriteOptions::Encoding;
   if (encoding == Encoding::kAscii) {
     out += "ascii\n";
-    char buffer[128];
-    for (std::size_t i = 0; i < n; ++i) {
-      const Point& p = cloud.points[i];
-      int len = std::snprintf(buffer, sizeof buffer, "%.9g %.9g %.9g", p.x(), p.y(), p.z());
-      out.append(buffer, static_cast<std::size_t>(len));
-      if (cloud.has_intensity()) {
-        len = std::snprintf(buffer, sizeof buffer, " %.9g", cloud.intensity[i]);
-        out.append(buffer, static_cast<std::size_t>(len));
-      }
-      if (cloud.has_ring()) {
-        out += ' ';
-        out += std::to_string(cloud.ring[i]);
-      }
-      if (cloud.has_time()) {
-        len = std::snprintf(buffer, sizeof buffer, " %.9g", cloud.time[i]);
-        out.append(buffer, static_cast<std::size_t>(len));
-      }
-      out += '\n';
-    }
+    for (std::size_t i = 0; i < n; ++i) append_point_text(out, cloud, i, ' ');
     return out;
   }
   std::size_t point_bytes = 0;
@@ -312,12 +294,7 @@ std::string format_pcd(const PointCloud& cloud, CloudWriteOptions::Encoding enco
   if (encoding == Encoding::kBinary) {
     out += "binary\n";
     out.reserve(out.size() + n * point_bytes);
-    for (std::size_t i = 0; i < n; ++i) {
-      append_bytes(out, cloud.points[i].data(), 12);
-      if (cloud.has_intensity()) append_bytes(out, &cloud.intensity[i], 4);
-      if (cloud.has_ring()) append_bytes(out, &cloud.ring[i], 2);
-      if (cloud.has_time()) append_bytes(out, &cloud.time[i], 4);
-    }
+    for (std::size_t i = 0; i < n; ++i) append_point_binary(out, cloud, i);
     return out;
   }
   out += "binary_compressed\n";

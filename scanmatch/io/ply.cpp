@@ -216,31 +216,11 @@ std::string format_ply(const PointCloud& cloud, CloudWriteOptions::Encoding enco
   if (cloud.has_ring()) out += "property ushort ring\n";
   if (cloud.has_time()) out += "property float t\n";
   out += "end_header\n";
-  char buffer[160];
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Point& p = cloud.points[i];
-    if (ascii) {
-      int len = std::snprintf(buffer, sizeof buffer, "%.9g %.9g %.9g", p.x(), p.y(), p.z());
-      out.append(buffer, static_cast<std::size_t>(len));
-      if (cloud.has_intensity()) {
-        len = std::snprintf(buffer, sizeof buffer, " %.9g", cloud.intensity[i]);
-        out.append(buffer, static_cast<std::size_t>(len));
-      }
-      if (cloud.has_ring()) {
-        out += ' ';
-        out += std::to_string(cloud.ring[i]);
-      }
-      if (cloud.has_time()) {
-        len = std::snprintf(buffer, sizeof buffer, " %.9g", cloud.time[i]);
-        out.append(buffer, static_cast<std::size_t>(len));
-      }
-      out += '\n';
-    } else {
-      append_bytes(out, p.data(), 12);
-      if (cloud.has_intensity()) append_bytes(out, &cloud.intensity[i], 4);
-      if (cloud.has_ring()) append_bytes(out, &cloud.ring[i], 2);
-      if (cloud.has_time()) append_bytes(out, &cloud.time[i], 4);
-    }
+    if (ascii)
+      append_point_text(out, cloud, i, ' ');
+    else
+      append_point_binary(out, cloud, i);
   }
   return out;
 }

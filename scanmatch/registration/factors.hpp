@@ -14,6 +14,18 @@
 
 namespace scanmatch {
 
+/// Adds the distance from T p to the line through q with direction d as the 3-vector
+/// (I - d d^T / |d|^2)(T p - q); false for a degenerate line. Shared by point-to-line and LOAM
+/// edges.
+inline bool add_point_to_line(const Pose& T, const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                              const Eigen::Vector3d& d, LinearSystem& system,
+                              const RobustKernel& kernel) {
+  if (d.squaredNorm() < 1e-10) return false;
+  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose() / d.squaredNorm();
+  system.add<3>(P * point_jacobian(T, p), P * (T * p - q), Eigen::Matrix3d::Identity(), kernel);
+  return true;
+}
+
 /// Point-to-point: r = T p - q, q the nearest target point (k-d tree, or exhaustive search).
 struct PointToPointFactor {
   const PointCloud& source;
@@ -71,13 +83,8 @@ struct PointToLineFactor {
     float d2[2];
     if (tree.knn(x.cast<float>(), 2, idx, d2) < 2 || d2[0] > max_distance * max_distance)
       return false;
-    const Eigen::Vector3d q1 = target.points[idx[0]].cast<double>(),
-                          q2 = target.points[idx[1]].cast<double>();
-    const Eigen::Vector3d d = q2 - q1;
-    if (d.squaredNorm() < 1e-12) return false;
-    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose() / d.squaredNorm();
-    system.add<3>(P * point_jacobian(T, p), P * (x - q1), Eigen::Matrix3d::Identity(), kernel);
-    return true;
+    const Eigen::Vector3d q1 = target.points[idx[0]].cast<double>();
+    return add_point_to_line(T, p, q1, target.points[idx[1]].cast<double>() - q1, system, kernel);
   }
 };
 

@@ -34,11 +34,7 @@ struct LoamEdgeFactor {
         break;
       }
     const Eigen::Vector3d q = target.points[idx[0]].cast<double>();
-    const Eigen::Vector3d d = target.points[r].cast<double>() - q;
-    if (d.squaredNorm() < 1e-8) return false;
-    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose() / d.squaredNorm();
-    system.add<3>(P * point_jacobian(T, p), P * (x - q), Eigen::Matrix3d::Identity(), kernel);
-    return true;
+    return add_point_to_line(T, p, q, target.points[r].cast<double>() - q, system, kernel);
   }
 };
 
