@@ -46,10 +46,12 @@ class VoxelSlots {
  public:
   static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
 
-  /// Empties the table; keeps the allocation between calls.
-  void reset() {
-    if (entries_.empty()) entries_.resize(kInitialCapacity);
-    std::fill(entries_.begin(), entries_.end(), Entry{{0, 0, 0}, kEmpty});
+  /// Empties the table, sized for about `expected` voxels (it still grows when needed); keeps
+  /// the allocation between calls, but never a table much larger than the work at hand.
+  void reset(std::size_t expected) {
+    std::size_t capacity = kInitialCapacity;
+    while (capacity < 2 * expected) capacity <<= 1;
+    entries_.assign(capacity, Entry{{0, 0, 0}, kEmpty});
     size_ = 0;
   }
 
@@ -125,8 +127,9 @@ PointCloud voxel_downsample(const PointCloud& cloud, double voxel_size, VoxelRed
   std::vector<Accumulator>& voxels = workspace.voxels;
   VoxelSlots& slots = workspace.slots;
   voxel_of_point.resize(n);
+  // The previous call's voxel count is the best guess for this one (consecutive frames).
+  slots.reset(voxels.size());
   voxels.clear();
-  slots.reset();
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3f s = cloud.points[i] * inv;
     if (!s.allFinite()) {
