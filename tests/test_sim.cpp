@@ -247,3 +247,27 @@ TEST(SimSimulator, PlanarPresetWritesACarmenLog) {
   for (float r : log.scans[0].ranges) valid += r > 0.15f && r < 4.0f;
   EXPECT_GT(valid, 250u);  // a robot in a room sees walls almost all around
 }
+
+TEST(SimSimulator, ReplaysARecordedTrajectory) {
+  // A TUM trajectory: 2 s driving straight along x at 1 m/s, turning 0.2 rad/s.
+  scanmatch::testing::TempDir dir;
+  Trajectory recorded;
+  for (int i = 0; i <= 20; ++i) {
+    const double t = 0.1 * i;
+    recorded.poses.push_back(from_xyz_rpy(t, 0.0, 0.0, 0.0, 0.0, 0.2 * t));
+    recorded.timestamps.push_back(100.0 + t);
+  }
+  write_trajectory(dir.file("drive.txt"), recorded, TrajectoryFormat::kTum);
+  SimOptions o;
+  o.preset = "dynamic-indoor";
+  o.trajectory_file = dir.file("drive.txt");
+  o.frames = 50;  // more than the recording covers: cut to its span
+  const Simulator sim(o);
+  EXPECT_EQ(sim.size(), 21u);
+  for (std::size_t i = 0; i < sim.size(); i += 5) {
+    const Pose expected = recorded.poses[0].inverse() * recorded.poses[i];
+    EXPECT_TRUE(sim.pose(i).isApprox(expected, 1e-6)) << "frame " << i;
+  }
+  EXPECT_NEAR(sim.path_length(), 2.0, 0.01);
+  EXPECT_GT(sim.frame(10).size(), 1000u);
+}
