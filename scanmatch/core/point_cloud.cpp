@@ -23,17 +23,6 @@ void PointCloud::resize(std::size_t n) {
   if (has_time()) time.resize(n, 0.0f);
 }
 
-void PointCloud::push_back_from(const PointCloud& other, std::size_t i) {
-  // Decide field presence before growing `points`, since has_*() reads the field sizes.
-  const bool keep_intensity = has_intensity() || (empty() && other.has_intensity());
-  const bool keep_ring = has_ring() || (empty() && other.has_ring());
-  const bool keep_time = has_time() || (empty() && other.has_time());
-  points.push_back(other.points[i]);
-  if (keep_intensity) intensity.push_back(other.has_intensity() ? other.intensity[i] : 0.0f);
-  if (keep_ring) ring.push_back(other.has_ring() ? other.ring[i] : 0);
-  if (keep_time) time.push_back(other.has_time() ? other.time[i] : 0.0f);
-}
-
 bool PointCloud::fields_consistent() const {
   const std::size_t n = size();
   return (intensity.empty() || intensity.size() == n) && (ring.empty() || ring.size() == n) &&

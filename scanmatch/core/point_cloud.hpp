@@ -34,9 +34,6 @@ struct PointCloud {
   void reserve(std::size_t n);
   /// Resizes every present field with the points (new entries zero).
   void resize(std::size_t n);
-  /// Appends point i of `other`. An empty cloud adopts other's fields; otherwise the fields present
-  /// here are kept (0 where `other` lacks them) and other's extra fields are dropped.
-  void push_back_from(const PointCloud& other, std::size_t i);
   /// True when every optional field is empty or has exactly size() entries.
   bool fields_consistent() const;
 };
