@@ -30,15 +30,15 @@ nlohmann::ordered_json cloud_info(const std::string& path) {
     hi = hi.cwiseMax(p);
   }
   nlohmann::ordered_json j = {{"kind", "cloud"},
-                      {"format", to_string(info.format)},
-                      {"encoding", info.encoding},
-                      {"gzip", info.compressed_gzip},
-                      {"points", cloud.size()},
-                      {"points_in_file", info.points_in_file},
-                      {"non_finite", info.non_finite},
-                      {"fields", info.fields},
-                      {"width", info.width},
-                      {"height", info.height}};
+                              {"format", to_string(info.format)},
+                              {"encoding", info.encoding},
+                              {"gzip", info.compressed_gzip},
+                              {"points", cloud.size()},
+                              {"points_in_file", info.points_in_file},
+                              {"non_finite", info.non_finite},
+                              {"fields", info.fields},
+                              {"width", info.width},
+                              {"height", info.height}};
   if (!cloud.empty()) {
     j["min"] = {lo.x(), lo.y(), lo.z()};
     j["max"] = {hi.x(), hi.y(), hi.z()};
@@ -49,9 +49,9 @@ nlohmann::ordered_json cloud_info(const std::string& path) {
 nlohmann::ordered_json trajectory_info(const std::string& path) {
   const Trajectory t = read_trajectory(path);
   nlohmann::ordered_json j = {{"kind", "trajectory"},
-                      {"format", t.has_timestamps() ? "TUM" : "KITTI"},
-                      {"poses", t.size()},
-                      {"path_length_m", t.path_length()}};
+                              {"format", t.has_timestamps() ? "TUM" : "KITTI"},
+                              {"poses", t.size()},
+                              {"path_length_m", t.path_length()}};
   if (t.has_timestamps()) j["duration_s"] = t.timestamps.back() - t.timestamps.front();
   return j;
 }
@@ -67,10 +67,10 @@ nlohmann::ordered_json carmen_info(const std::string& path) {
       path_length += (log.scans[i].pose.head<2>() - log.scans[i - 1].pose.head<2>()).norm();
   }
   nlohmann::ordered_json j = {{"kind", "CARMEN log"},
-                      {"laser_scans", log.scans.size()},
-                      {"odometry_records", log.odometry.size()},
-                      {"other_records", log.ignored_lines},
-                      {"reference_path_length_m", path_length}};
+                              {"laser_scans", log.scans.size()},
+                              {"odometry_records", log.odometry.size()},
+                              {"other_records", log.ignored_lines},
+                              {"reference_path_length_m", path_length}};
   if (!log.scans.empty()) {
     j["beams_min"] = min_beams;
     j["beams_max"] = max_beams;
@@ -82,9 +82,9 @@ nlohmann::ordered_json carmen_info(const std::string& path) {
 nlohmann::ordered_json sequence_info(const std::string& path) {
   const auto sequence = open_sequence_folder(path);
   nlohmann::ordered_json j = {{"kind", "sequence"},
-                      {"description", sequence->describe()},
-                      {"frames", sequence->size()},
-                      {"ground_truth", static_cast<bool>(sequence->ground_truth())}};
+                              {"description", sequence->describe()},
+                              {"frames", sequence->size()},
+                              {"ground_truth", static_cast<bool>(sequence->ground_truth())}};
   if (const auto gt = sequence->ground_truth()) j["ground_truth_path_length_m"] = gt->path_length();
   return j;
 }

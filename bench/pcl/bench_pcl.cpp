@@ -103,7 +103,8 @@ void BM_Pcl(benchmark::State& state) {
       iterations = ndt.getFinalNumIteration();
     }
   }
-  report(state, pair, from_matrix(result.cast<double>()), iterations, "PCL " + method + " " + preset);
+  report(state, pair, from_matrix(result.cast<double>()), iterations,
+         "PCL " + method + " " + preset);
 }
 
 void BM_Ours(benchmark::State& state) {
