@@ -4,6 +4,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
+#include "test_helpers.hpp"
 
 using namespace scanmatch;
 
@@ -138,4 +139,20 @@ TEST(Associate, ByTimestampMatchesNearest) {
   EXPECT_TRUE(a.ground_truth[0].isApprox(gt.poses[2]));
   EXPECT_TRUE(a.ground_truth[1].isApprox(gt.poses[5]));
   EXPECT_THROW(associate(gt, est, false), Error);  // 2 of 10 matched
+}
+
+TEST(Cli, EvalOfGroundTruthAgainstItselfIsZero) {
+  scanmatch::testing::TempDir dir;
+  const auto sim = scanmatch::testing::run_cli(
+      "simulate dynamic-outdoor-fast --frames 30 --quiet --out " + dir.file("ds"));
+  ASSERT_EQ(sim.status, 0) << sim.output;
+  const auto run = scanmatch::testing::run_cli("eval --json --gt " + dir.file("ds/poses_gt.txt") +
+                                               " --est " + dir.file("ds/poses_gt_tum.txt"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("\"rmse_m\": 0.0"), std::string::npos) << run.output;
+  // KITTI poses have no timestamps: association by index, and it says so.
+  EXPECT_NE(run.output.find("by index"), std::string::npos);
+  const auto mismatch = scanmatch::testing::run_cli("eval --gt " + dir.file("ds/poses_gt.txt") +
+                                                    " --est " + dir.file("ds/times.txt"));
+  EXPECT_NE(mismatch.status, 0);
 }
