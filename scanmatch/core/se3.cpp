@@ -153,6 +153,12 @@ Eigen::Matrix<double, 6, 1> to_xyz_rpy(const Pose& T) {
   return out;
 }
 
+Pose orthonormalized(const Pose& T) {
+  Pose out = T;
+  out.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+  return out;
+}
+
 bool is_valid_pose(const Eigen::Matrix4d& M, double tolerance) {
   if (!M.allFinite()) return false;
   const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();

@@ -50,6 +50,10 @@ Pose from_xyz_rpy(double x, double y, double z, double roll, double pitch, doubl
 /// Inverse of from_xyz_rpy, pitch in [-pi/2, pi/2].
 Eigen::Matrix<double, 6, 1> to_xyz_rpy(const Pose& T);
 
+/// T with its rotation block projected back onto SO(3) (via a normalised quaternion): products of
+/// many poses drift from orthonormality, and feedback loops (velocity priors) amplify that drift.
+Pose orthonormalized(const Pose& T);
+
 /// True when every entry is finite and the rotation block is orthonormal within `tolerance`.
 bool is_valid_pose(const Eigen::Matrix4d& M, double tolerance = 1e-6);
 

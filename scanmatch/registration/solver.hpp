@@ -189,7 +189,7 @@ RegistrationResult optimize(const Factor& factor, const Pose& initial,
       result.stop_reason = "singular system";
       break;
     }
-    const Pose candidate = T * se3_exp(delta);
+    const Pose candidate = orthonormalized(T * se3_exp(delta));
     LinearSystem next = linearize_all(factor, candidate, options);
     if (options.levenberg_marquardt && next.cost > system.cost && next.inliers >= system.inliers) {
       lambda *= 10.0;  // reject the step, damp more
