@@ -4,7 +4,7 @@
 // stage on the global Gaussian map with eigenvalues normalised to (1, 1, 1e-6), map update that
 // merges a voxel once 5 new points are pending, map bounded by a radius). Every other registration
 // method runs frame-to-frame from the same prior, as in the papers' comparisons.
-// (First version: no degeneracy guard yet; the deskew uses the constant-velocity prior only.)
+// (First version: no degeneracy guard yet; deskewing uses the previous frame's motion.)
 
 #include <string>
 
@@ -24,8 +24,7 @@ struct OdometryConfig {
   bool fine_stage = true;             ///< ablation: false = coarse only
   bool map_update = true;             ///< ablation: false = the map of the first frame only
   /// Move each point to the frame start with the previous frame's motion (needs point times).
-  /// Off by default: with the raw previous estimate it feeds back and oscillates (seen at 4.4 m/s).
-  bool deskew = false;
+  bool deskew = true;
   double max_jump = 1.0;         ///< m: a result farther than this from the prior is rejected
   double max_jump_angle = 0.35;  ///< rad: likewise for rotation
   int threads = 1;
