@@ -11,5 +11,9 @@ void add_convert_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_register_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
+void add_odometry_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+void add_report_command(CLI::App& app);
+void add_map2d_command(CLI::App& app);
 
 }  // namespace scanmatch::cli

@@ -13,6 +13,10 @@ int main(int argc, char** argv) {
   scanmatch::cli::add_simulate_command(app);
   scanmatch::cli::add_register_command(app);
   scanmatch::cli::add_eval_command(app);
+  scanmatch::cli::add_odometry_command(app);
+  scanmatch::cli::add_bench_command(app);
+  scanmatch::cli::add_report_command(app);
+  scanmatch::cli::add_map2d_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

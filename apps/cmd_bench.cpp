@@ -1,0 +1,12 @@
+#include "apps/commands.hpp"
+#include "scanmatch/core/error.hpp"
+
+namespace scanmatch::cli {
+
+// Placeholder: being written (see the open issues).
+void add_bench_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("bench", "(not yet available)");
+  cmd->callback([] { throw Error("'scanmatch bench' is not implemented yet"); });
+}
+
+}  // namespace scanmatch::cli

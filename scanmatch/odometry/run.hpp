@@ -1,0 +1,59 @@
+#pragma once
+// Runs an odometry pipeline over a whole sequence and writes a run folder (RUNDIR):
+//   poses.txt       KITTI rows, one per frame, sensor pose in the world frame of frame 0
+//   poses_tum.txt   the same poses as TUM rows (timestamp tx ty tz qx qy qz qw)
+//   timing.csv      per frame: index,timestamp,preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,
+//                   points_in,points_downsampled,iterations,condition_number,bridged
+//   summary.json    method, options (the whole configuration), frames, mean and max ms per stage,
+//                   frames per second, whether the run was interrupted (written atomically at end)
+//   config.json     the OdometryConfig used (reloadable with --config)
+//   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
+// Per-frame files are appended and flushed frame by frame, so an interrupted run keeps its frames.
+// Timing covers the pipeline only (register_frame), never reading or simulating the frames.
+
+#include <atomic>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "scanmatch/io/sequence.hpp"
+#include "scanmatch/odometry/odometry.hpp"
+
+namespace scanmatch {
+
+struct RunOptions {
+  std::string out_dir;             ///< RUNDIR (created); empty: write nothing
+  std::size_t max_frames = 0;      ///< 0: every frame of the source
+  bool write_map = false;          ///< write RUNDIR/map.<map_format>
+  std::string map_format = "pcd";  ///< "pcd" or "ply"
+  double map_voxel_size = 0.1;     ///< m, downsampling of the exported map
+  double map_export_radius = 0.0;  ///< m around the last pose; 0: unbounded (the whole run)
+  bool quiet = false;              ///< no progress line
+  /// Set to true (e.g. from a SIGINT handler) to stop after the current frame; the run then
+  /// finishes its files and reports interrupted = true.
+  const std::atomic<bool>* stop = nullptr;
+};
+
+struct StageStatistics {
+  double mean_ms = 0.0, max_ms = 0.0;
+};
+
+struct RunSummary {
+  std::string method;
+  std::string source;  ///< SequenceSource::describe()
+  std::size_t frames = 0, bridged_frames = 0;
+  bool interrupted = false;
+  StageStatistics preprocess, coarse, fine, map_update, total;
+  double frames_per_second = 0.0;  ///< 1000 / mean total ms (pipeline time only)
+  std::vector<double> timestamps;  ///< per frame
+  std::vector<Pose> poses;         ///< per frame, world frame of frame 0
+  std::vector<FrameStats> stats;   ///< per frame
+};
+
+/// Runs `config` over `source` (from its current position) and writes RUNDIR as described above.
+/// Bad frames (empty, unreadable) are reported on stderr and bridged, never fatal; a frame the
+/// source cannot deliver at all (Error from next()) ends the run with that error.
+RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
+                        const RunOptions& options);
+
+}  // namespace scanmatch
