@@ -59,6 +59,8 @@ void GaussianVoxelMap::update_cache(GaussianVoxel& v) const {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(v.covariance);
   const Eigen::Matrix3d& Q = solver.eigenvectors();  // ascending eigenvalues
   v.normal = Q.col(0);
+  const Eigen::Vector3d& e = solver.eigenvalues();
+  v.flatness = e(1) > 0.0 ? static_cast<float>(std::max(e(0), 0.0) / e(1)) : 1.0f;
   const double eps = options_.planar_epsilon;
   v.planar_information = Q * Eigen::Vector3d(1.0 / eps, 1.0, 1.0).asDiagonal() * Q.transpose();
   const Eigen::Vector3d lambda =
@@ -89,6 +91,7 @@ std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) 
     if (!p.allFinite()) continue;
     const VoxelIndex index = index_of(p);
     GaussianVoxel& v = voxels_[index];
+    if (options_.max_points > 0 && v.count >= options_.max_points) continue;
     const Eigen::Vector3d local =
         p - Eigen::Vector3d(index.x, index.y, index.z) * options_.voxel_size;
     if (v.last_insert != call) {

@@ -37,6 +37,8 @@ struct GaussianVoxel {
       Eigen::Matrix3d::Identity();  ///< eigenvalues >= 1e-3 max
   Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
+  /// Smallest over middle eigenvalue: near 0 for a plane, up to 1 for a blob or a corner.
+  float flatness = 1.0f;
   /// Points waiting to be merged (sums relative to the voxel's corner for precision).
   std::uint32_t pending = 0;
   std::uint64_t last_insert = 0;  ///< which insert() call last touched the voxel
@@ -49,6 +51,9 @@ struct GaussianVoxelMapOptions {
   std::uint32_t merge_threshold = 1;  ///< pending points needed before a merge (CTF-ICP: 5)
   std::uint32_t min_points = 5;       ///< a voxel is used for registration from this many points
   double planar_epsilon = 1e-6;       ///< smallest eigenvalue of the planar covariance (CTF: 1e-6)
+  /// A voxel whose Gaussian holds this many points takes no more (0: no limit). Mature voxels then
+  /// stay fixed, so small registration errors of later frames cannot drag the map along.
+  std::uint32_t max_points = 0;
 };
 
 class GaussianVoxelMap {

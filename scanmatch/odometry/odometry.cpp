@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/registration/ctf_fine.hpp"
 #include "scanmatch/registration/factors.hpp"
 
 namespace scanmatch {
@@ -19,18 +23,175 @@ GaussianVoxelMapOptions map_options(const OdometryConfig& c) {
   o.voxel_size = c.map_voxel_size;
   o.merge_threshold = c.merge_threshold;
   o.planar_epsilon = c.registration.ctf_epsilon;
+  o.max_points = c.map_voxel_max_points;
+  o.min_points = c.map_voxel_min_points;
   return o;
 }
+
+GaussianVoxelMapOptions ndt_options(const OdometryConfig& c) {
+  GaussianVoxelMapOptions o;
+  o.voxel_size = c.ndt_resolution;
+  return o;
+}
+
+void check_config(const OdometryConfig& c) {
+  if (c.method != "ctf-icp") {
+    const auto names = registration_method_names();
+    if (std::find(names.begin(), names.end(), c.method) == names.end()) {
+      std::string valid = "ctf-icp";
+      for (const auto& n : names) valid += ", " + n;
+      throw Error("unknown odometry method '" + c.method + "' (valid: " + valid + ")");
+    }
+  }
+  const auto positive = [](double v, const char* name) {
+    if (!(v > 0.0) || !std::isfinite(v))
+      throw Error(std::string("odometry: ") + name + " must be positive");
+  };
+  positive(c.ndt_resolution, "ndt_resolution");
+  positive(c.map_voxel_size, "map_voxel_size");
+  positive(c.map_radius, "map_radius");
+  positive(c.max_range, "max_range");
+  if (c.voxel_size < 0.0 || c.coarse_voxel_size < 0.0 || c.min_range < 0.0)
+    throw Error("odometry: voxel sizes and min_range must not be negative");
+  if (c.merge_threshold == 0) throw Error("odometry: merge_threshold must be at least 1");
+  if (c.threads < 1) throw Error("odometry: threads must be at least 1");
+}
+
+// Deskewing with the constant-velocity motion over the frame: the transform at each of `bins`
+// instants is exact; between them a first-order step (I + ds xi^) is accurate to O(ds^2 |w|^2).
+class FrameMotion {
+ public:
+  FrameMotion(const Pose& motion, double period, double max_time) : xi_(se3_log(motion) / period) {
+    step_ = std::max(max_time, 1e-6) / (kBins - 1);
+    for (int k = 0; k < kBins; ++k) bins_[k] = se3_exp(xi_ * (k * step_)).matrix().cast<float>();
+  }
+  Point apply(const Point& p, float t) const {
+    const int k = std::clamp(static_cast<int>(std::lround(t / step_)), 0, kBins - 1);
+    const float ds = t - static_cast<float>(k * step_);
+    const Eigen::Vector3f w = xi_.head<3>().cast<float>(), v = xi_.tail<3>().cast<float>();
+    const Point q = p + ds * (w.cross(p) + v);
+    return bins_[k].topLeftCorner<3, 3>() * q + bins_[k].topRightCorner<3, 1>();
+  }
+
+ private:
+  static constexpr int kBins = 64;
+  Vector6d xi_;  ///< twist per second
+  double step_;
+  Eigen::Matrix4f bins_[kBins];
+};
 }  // namespace
 
-Odometry::Odometry(const OdometryConfig& config) : config_(config), map_(map_options(config)) {
-  if (config.method != "ctf-icp") {
-    const auto names = registration_method_names();
-    if (std::find(names.begin(), names.end(), config.method) == names.end())
-      throw Error("unknown odometry method '" + config.method +
-                  "' (ctf-icp or a registration method)");
-  }
+Odometry::Odometry(const OdometryConfig& config)
+    : config_(config), map_(map_options(config)), previous_ndt_(ndt_options(config)) {
+  check_config(config);
   config_.registration.solver.num_threads = config.threads;
+  ndt_score_constants(config.ndt_resolution, config.registration.ndt_outlier_ratio, ndt_d1_,
+                      ndt_d2_);
+}
+
+PointCloud Odometry::preprocess(const PointCloud& frame) const {
+  const double min2 = config_.min_range * config_.min_range,
+               max2 = config_.max_range * config_.max_range;
+  const bool deskew = config_.deskew && frame.has_time() && frames_ > 1 &&
+                      (velocity_.translation().norm() >= config_.deskew_min_translation ||
+                       rotation_angle(velocity_) >= config_.deskew_min_rotation);
+  float max_time = 0.0f;
+  if (deskew)
+    for (float t : frame.time)
+      if (std::isfinite(t)) max_time = std::max(max_time, t);
+  const FrameMotion motion(velocity_, frame_period_, max_time);
+  PointCloud kept;
+  kept.reserve(frame.size());
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    const Point& p = frame.points[i];
+    const double r2 = p.squaredNorm();
+    if (!p.allFinite() || r2 < min2 || r2 > max2) continue;
+    if (deskew && std::isfinite(frame.time[i]))
+      kept.points.push_back(motion.apply(p, frame.time[i]));
+    else
+      kept.points.push_back(p);
+  }
+  return config_.voxel_size > 0.0 ? voxel_downsample(kept, config_.voxel_size) : kept;
+}
+
+Pose Odometry::register_baseline(const PointCloud& down, const Pose& predicted) {
+  if (down.size() < minimum_points(config_.method, config_.registration) ||
+      previous_.size() < minimum_points(config_.method, config_.registration)) {
+    stats_.bridged = true;
+    return predicted;
+  }
+  const auto start = Clock::now();
+  RegistrationOptions o = config_.registration;
+  o.method = config_.method;
+  const RegistrationResult r = register_clouds(down, previous_, o, velocity_);
+  stats_.coarse_ms = ms_since(start);
+  stats_.iterations = r.iterations;
+  stats_.condition_number = r.condition_number;
+  return pose_ * r.transform;
+}
+
+Pose Odometry::register_ctf(const PointCloud& down, const Pose& predicted) {
+  constexpr std::size_t kMinimumPoints = 20;
+  if (down.size() < kMinimumPoints) {
+    stats_.bridged = true;
+    return predicted;
+  }
+  // Coarse: NDT frame-to-frame, the increment from the previous frame starting at the prior.
+  const auto coarse_start = Clock::now();
+  Pose estimate = predicted;
+  if (previous_ndt_.size() > 0) {
+    const PointCloud coarse_source = config_.coarse_voxel_size > config_.voxel_size
+                                         ? voxel_downsample(down, config_.coarse_voxel_size)
+                                         : down;
+    SolverOptions solver = config_.registration.solver;
+    solver.max_iterations = config_.coarse_max_iterations;
+    solver.rotation_tolerance = solver.translation_tolerance = 1e-4;
+    solver.kernel = RobustKernel{};
+    const RegistrationResult coarse =
+        optimize(NdtFactor{coarse_source, previous_ndt_, config_.ndt_neighbours, ndt_d1_, ndt_d2_},
+                 velocity_, solver);
+    stats_.iterations = coarse.iterations;
+    stats_.condition_number = coarse.condition_number;
+    if (coarse.inliers >= kMinimumPoints) estimate = pose_ * coarse.transform;
+  }
+  stats_.coarse_ms = ms_since(coarse_start);
+
+  // Fine: frame-to-map on the planar Gaussians.
+  if (config_.fine_stage && map_.size() > 0) {
+    const auto fine_start = Clock::now();
+    CtfFineOptions fine_options;
+    fine_options.max_associations = config_.fine_max_iterations;
+    fine_options.max_flatness = static_cast<float>(config_.fine_max_flatness);
+    SolverOptions& solver = fine_options.solver;
+    solver = config_.registration.solver;
+    solver.degeneracy_ratio = config_.degeneracy_ratio;
+    solver.kernel = RobustKernel{};
+    if (config_.fine_kernel_distance > 0.0) {
+      // The residual is weighted by 1/eps along the normal: scale the kernel to match.
+      solver.kernel.type = KernelType::kCauchy;
+      solver.kernel.scale =
+          config_.fine_kernel_distance / std::sqrt(config_.registration.ctf_epsilon);
+    }
+    const RegistrationResult fine = register_ctf_fine(down, map_, estimate, fine_options);
+    if (std::getenv("SCANMATCH_TRACE_FINE"))
+      std::fprintf(stderr, "fine: %s; start->end %.5f m, %d it\n", fine.stop_reason.c_str(),
+                   (estimate.inverse() * fine.transform).translation().norm(), fine.iterations);
+    if (fine.inliers >= kMinimumPoints) {
+      estimate = fine.transform;
+      if (config_.degeneracy_ratio > 0.0) {
+        // Along degenerate directions neither stage can be trusted: keep the motion prior there.
+        const Degeneracy d =
+            analyse_degeneracy(fine.information, solver.degeneracy_range, config_.degeneracy_ratio);
+        stats_.degenerate_directions = d.directions;
+        if (d.directions > 0)
+          estimate = predicted * se3_exp(d.projector * se3_log(predicted.inverse() * estimate));
+      }
+    }
+    stats_.fine_ms = ms_since(fine_start);
+    stats_.iterations += fine.iterations;
+    stats_.condition_number = fine.condition_number;
+  }
+  return estimate;
 }
 
 Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
@@ -39,57 +200,22 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   stats_.points_in = frame.size();
   if (frames_ > 0 && timestamp > last_timestamp_) frame_period_ = timestamp - last_timestamp_;
   last_timestamp_ = timestamp;
-  PointCloud down;
-  if (config_.deskew && frame.has_time() && frames_ > 1) {
-    // Each point was measured at its own time offset: move it into the frame-start sensor frame
-    // by the fraction of the (constant-velocity) frame motion that had happened by then.
-    const Vector6d xi = se3_log(velocity_);
-    PointCloud deskewed = frame;
-    for (std::size_t i = 0; i < frame.size(); ++i)
-      deskewed.points[i] =
-          (se3_exp(xi * (frame.time[i] / frame_period_)) * frame.points[i].cast<double>())
-              .cast<float>();
-    down = voxel_downsample(deskewed, config_.voxel_size);
-  } else {
-    down = voxel_downsample(frame, config_.voxel_size);
-  }
+  PointCloud down = frame.size() == frame.time.size() || frame.time.empty()
+                        ? preprocess(frame)
+                        : PointCloud{};  // inconsistent fields: treated as an empty frame
   stats_.points_downsampled = down.size();
   stats_.preprocess_ms = ms_since(start);
 
   const Pose predicted = pose_ * velocity_;
-  Pose estimate = predicted;
   const bool ctf = config_.method == "ctf-icp";
-  if (frames_ > 0 && down.size() >= 20 && previous_.size() >= 20) {
+  Pose estimate = predicted;
+  if (frames_ > 0) {
     try {
-      // Coarse (ctf-icp: NDT) or the baseline's own frame-to-frame registration from the prior.
-      const auto coarse_start = Clock::now();
-      RegistrationOptions o = config_.registration;
-      o.method = ctf ? "ndt" : config_.method;
-      if (ctf) o.voxel_resolution = config_.ndt_resolution;
-      const RegistrationResult coarse = register_clouds(down, previous_, o, velocity_);
-      estimate = pose_ * coarse.transform;
-      stats_.coarse_ms = ms_since(coarse_start);
-      stats_.iterations = coarse.iterations;
-      stats_.condition_number = coarse.condition_number;
-      if (ctf && config_.fine_stage && map_.size() > 0) {
-        const auto fine_start = Clock::now();
-        // Levenberg-Marquardt: with the stiff (1, 1, 1e-6) information and one voxel per point the
-        // cost jumps where points change voxels; only cost-decreasing steps are taken.
-        SolverOptions fine_solver = config_.registration.solver;
-        fine_solver.levenberg_marquardt = true;
-        const RegistrationResult fine =
-            optimize(CtfFineFactor{down, map_, 1}, estimate, fine_solver);
-        if (fine.inliers >= 20) estimate = fine.transform;
-        stats_.fine_ms = ms_since(fine_start);
-        stats_.iterations += fine.iterations;
-        stats_.condition_number = fine.condition_number;
-      }
+      estimate = ctf ? register_ctf(down, predicted) : register_baseline(down, predicted);
     } catch (const Error&) {
       stats_.bridged = true;  // too few points or correspondences: keep the motion prior
       estimate = predicted;
     }
-  } else if (frames_ > 0) {
-    stats_.bridged = true;
   }
   // Never let a failed solve poison the trajectory: a result far from the motion prior (or not
   // finite) is replaced by the prior.
@@ -99,20 +225,29 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
     stats_.bridged = true;
     estimate = predicted;
   }
+  estimate = orthonormalized(estimate);
 
-  if (ctf && (config_.map_update || frames_ == 0)) {
+  if (ctf) {
     const auto map_start = Clock::now();
-    map_.insert(down, estimate);
-    if (frames_ == 0) map_.flush();  // the first frame builds the map at once
-    map_.remove_far(estimate.translation(), config_.map_radius);
+    if (config_.map_update) {
+      map_.insert(down, estimate);
+      if (frames_ == 0) map_.flush();  // the first frame builds the map at once
+      map_.remove_far(estimate.translation(), config_.map_radius);
+    } else if (down.size() > 0) {
+      // Ablation: the fine stage sees only the previous frame (no map building or update).
+      map_ = GaussianVoxelMap(map_options(config_));
+      map_.insert(down, estimate);
+      map_.flush();
+    }
+    previous_ndt_ = GaussianVoxelMap(ndt_options(config_));
+    previous_ndt_.insert(down);
     stats_.map_ms = ms_since(map_start);
   }
   // A bridged frame keeps the last good velocity rather than one derived from the prior itself.
-  estimate = orthonormalized(estimate);
-  if (!stats_.bridged)
+  if (!stats_.bridged && config_.constant_velocity)
     velocity_ = frames_ > 0 ? orthonormalized(pose_.inverse() * estimate) : Pose::Identity();
   pose_ = estimate;
-  previous_ = std::move(down);
+  if (!down.empty() || !stats_.bridged) previous_ = std::move(down);
   ++frames_;
   stats_.total_ms = ms_since(start);
   return pose_;

@@ -1,11 +1,19 @@
 #pragma once
-// LiDAR odometry: one pipeline configured by method. `ctf-icp` is METHODS.md section 1 (voxel
-// downsampling, NDT frame-to-frame coarse stage from a constant-velocity prior, frame-to-map fine
-// stage on the global Gaussian map with eigenvalues normalised to (1, 1, 1e-6), map update that
-// merges a voxel once 5 new points are pending, map bounded by a radius). Every other registration
-// method runs frame-to-frame from the same prior, as in the papers' comparisons.
-// (First version: no degeneracy guard yet; deskewing uses the previous frame's motion.)
+// LiDAR odometry: one pipeline configured by method.
+//
+// `ctf-icp` is METHODS.md section 1: deskew and voxel-downsample the frame; coarse stage NDT
+// frame-to-frame (against the previous frame's NDT grid, from the constant-velocity prior); fine
+// stage frame-to-map on the global Gaussian map with covariance eigenvalues normalised to
+// (1, 1, 1e-6); map update that merges a voxel once 5 new points are pending (merge rule of the
+// paper with the outer-product term); the map keeps only voxels within `map_radius` of the sensor.
+// Every other method is a registration method (registration/methods.hpp) run frame-to-frame from
+// the same prior, as in the papers' comparisons.
+//
+// Degeneracy: the fine stage's information matrix is analysed each frame (solver.hpp,
+// analyse_degeneracy); along directions it does not constrain (a plain corridor's axis) the
+// solver makes no update and the pose keeps the constant-velocity prior there.
 
+#include <cstddef>
 #include <string>
 
 #include "scanmatch/core/point_cloud.hpp"
@@ -15,45 +23,87 @@
 namespace scanmatch {
 
 struct OdometryConfig {
-  std::string method = "ctf-icp";     ///< ctf-icp or any registration method (frame-to-frame)
-  double voxel_size = 0.25;           ///< m, downsampling of every frame
-  double ndt_resolution = 1.0;        ///< m, the coarse NDT grid
+  std::string method = "ctf-icp";  ///< ctf-icp or any registration method (frame-to-frame)
+  double voxel_size = 0.25;        ///< m, downsampling of every frame (0: none)
+  double min_range = 0.3;          ///< m: nearer points (the robot itself) are dropped
+  double max_range = 100.0;        ///< m: farther points are dropped
+  // Coarse stage (ctf-icp): NDT against the previous frame.
+  double ndt_resolution = 1.0;     ///< m, the NDT grid of the previous frame
+  int ndt_neighbours = 1;          ///< voxels per point: 1, 7 or 27
+  double coarse_voxel_size = 0.5;  ///< m, further downsampling of the NDT source (0: none)
+  int coarse_max_iterations = 10;
+  // Fine stage (ctf-icp): frame-to-map.
   double map_voxel_size = 0.5;        ///< m, the global Gaussian map
   std::uint32_t merge_threshold = 5;  ///< points pending before a map voxel is merged
   double map_radius = 80.0;           ///< m, map voxels farther from the sensor are dropped
-  bool fine_stage = true;             ///< ablation: false = coarse only
-  bool map_update = true;             ///< ablation: false = the map of the first frame only
-  /// Move each point to the frame start with the previous frame's motion (needs point times).
+  /// Points a map voxel needs before the fine stage uses it.
+  std::uint32_t map_voxel_min_points = 5;
+  /// Points after which a map voxel is frozen (GaussianVoxelMapOptions::max_points; 0: never).
+  std::uint32_t map_voxel_max_points = 0;
+  int fine_max_iterations = 10;
+  /// Map voxels flatter than this (smallest / middle eigenvalue) are used; 1: all (the paper).
+  double fine_max_flatness = 1.0;
+  /// m: plane distance where the fine stage's Cauchy kernel starts to down-weight (0: no kernel)
+  double fine_kernel_distance = 0.1;
+  /// Degeneracy guard of the fine stage (SolverOptions::degeneracy_ratio; 0: off).
+  double degeneracy_ratio = 0.02;
+  // Ablations of the paper's Table 5.
+  bool fine_stage = true;  ///< false: coarse NDT only
+  /// false: no global map; the fine stage registers against a map of the previous frame only.
+  bool map_update = true;
+  /// Constant-velocity motion prior; false: the previous pose is the initial guess.
+  bool constant_velocity = true;
+  /// Move each point to the frame start with the constant-velocity motion (needs point times).
   bool deskew = true;
+  /// Frames whose motion prior is below both thresholds are not deskewed: their distortion is
+  /// below the sensor noise, and deskewing by a velocity that is itself estimation noise feeds that
+  /// noise back into the next pose (a still sensor then drifts).
+  double deskew_min_translation = 0.01;  ///< m per frame
+  double deskew_min_rotation = 0.002;    ///< rad per frame
   double max_jump = 1.0;         ///< m: a result farther than this from the prior is rejected
   double max_jump_angle = 0.35;  ///< rad: likewise for rotation
   int threads = 1;
-  RegistrationOptions registration;  ///< solver and method parameters
+  RegistrationOptions registration;  ///< parameters of the frame-to-frame baselines
 };
 
 struct FrameStats {
   double preprocess_ms = 0, coarse_ms = 0, fine_ms = 0, map_ms = 0, total_ms = 0;
   std::size_t points_in = 0, points_downsampled = 0;
-  int iterations = 0;
-  double condition_number = 0;
-  bool bridged = false;  ///< the frame could not be registered: the motion prior was used
+  int iterations = 0;             ///< coarse plus fine
+  double condition_number = 0;    ///< of the last stage's information matrix
+  int degenerate_directions = 0;  ///< directions the fine stage left at the motion prior
+  bool bridged = false;           ///< the frame could not be registered: the motion prior was used
 };
 
 class Odometry {
  public:
+  /// Throws Error for an unknown method or invalid parameters.
   explicit Odometry(const OdometryConfig& config);
-  /// Registers the next frame; returns its pose in the world frame of the first frame.
+  /// Registers the next frame (points in the sensor frame; per-point `time` offsets from the frame
+  /// start enable deskewing) taken at `timestamp` seconds; returns the sensor pose at the frame
+  /// start in the world frame of the first frame. Never throws for bad frames: an empty or
+  /// unregistrable frame is bridged by the motion prior (last_stats().bridged).
   Pose register_frame(const PointCloud& frame, double timestamp);
+  /// The global Gaussian map (ctf-icp), in the world frame.
   const GaussianVoxelMap& map() const { return map_; }
+  /// The last registered frame, downsampled and deskewed, in its sensor frame.
+  const PointCloud& last_frame() const { return previous_; }
   const FrameStats& last_stats() const { return stats_; }
   const OdometryConfig& config() const { return config_; }
+  std::size_t frames() const { return frames_; }
 
  private:
+  PointCloud preprocess(const PointCloud& frame) const;
+  Pose register_ctf(const PointCloud& down, const Pose& predicted);
+  Pose register_baseline(const PointCloud& down, const Pose& predicted);
+
   OdometryConfig config_;
   GaussianVoxelMap map_;
+  GaussianVoxelMap previous_ndt_;  ///< the previous frame's NDT grid, in its sensor frame
   PointCloud previous_;
   Pose pose_ = Pose::Identity(), velocity_ = Pose::Identity();  ///< velocity_: last frame's motion
   double last_timestamp_ = 0.0, frame_period_ = 0.1;
+  double ndt_d1_ = 0.0, ndt_d2_ = 0.0;
   std::size_t frames_ = 0;
   FrameStats stats_;
 };

@@ -166,6 +166,9 @@ struct CtfFineFactor {
   const PointCloud& source;
   const GaussianVoxelMap& map;
   int neighbours;
+  /// Voxels whose flatness (smallest / middle eigenvalue) exceeds this are not planes (corners,
+  /// foliage) and are skipped; 1 keeps every voxel, as the paper does.
+  float max_flatness = 1.0f;
   std::size_t size() const { return source.size(); }
   bool linearize(const Pose& T, std::size_t i, LinearSystem& system,
                  const RobustKernel& kernel) const {
@@ -173,6 +176,7 @@ struct CtfFineFactor {
     const Eigen::Matrix<double, 3, 6> J = point_jacobian(T, p);
     bool any = false;
     map.for_each_neighbour(x, neighbours, [&](const GaussianVoxel& v) {
+      if (v.flatness > max_flatness) return;
       system.add<3>(J, x - v.mean, v.planar_information, kernel);
       any = true;
     });

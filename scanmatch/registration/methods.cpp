@@ -70,16 +70,6 @@ RegistrationResult icp_closed_form(const PointToPointFactor& factor, const Pose&
   return result;
 }
 
-// Magnusson's constants of the Gaussian fitted to the mixture of a normal and a uniform outlier
-// distribution, for voxel size `resolution` and outlier probability `outlier_ratio`.
-void ndt_constants(double resolution, double outlier_ratio, double& d1, double& d2) {
-  const double c1 = 10.0 * (1.0 - outlier_ratio);
-  const double c2 = outlier_ratio / (resolution * resolution * resolution);
-  const double d3 = -std::log(c2);
-  d1 = -std::log(c1 + c2) - d3;
-  d2 = -2.0 * std::log((-std::log(c1 * std::exp(-0.5) + c2) - d3) / d1);
-}
-
 GaussianVoxelMap target_map(const PointCloud& target, const RegistrationOptions& o) {
   GaussianVoxelMapOptions m;
   m.voxel_size = o.voxel_resolution;
@@ -106,6 +96,16 @@ Eigen::Matrix3d floored_covariance(const Eigen::Matrix3d& C) {
 }
 
 }  // namespace
+
+// Magnusson's constants of the Gaussian fitted to the mixture of a normal and a uniform outlier
+// distribution, for voxel size `resolution` and outlier probability `outlier_ratio`.
+void ndt_score_constants(double resolution, double outlier_ratio, double& d1, double& d2) {
+  const double c1 = 10.0 * (1.0 - outlier_ratio);
+  const double c2 = outlier_ratio / (resolution * resolution * resolution);
+  const double d3 = -std::log(c2);
+  d1 = -std::log(c1 + c2) - d3;
+  d2 = -2.0 * std::log((-std::log(c1 * std::exp(-0.5) + c2) - d3) / d1);
+}
 
 std::vector<std::string> registration_method_names() {
   return {"icp",   "icp-kdtree", "icp-brute", "icp-gn", "point-to-plane", "point-to-line", "gicp",
@@ -182,7 +182,7 @@ RegistrationResult register_clouds(const PointCloud& source, const PointCloud& t
   const GaussianVoxelMap map = target_map(target, o);
   if (m == "ndt") {
     double d1, d2;
-    ndt_constants(o.voxel_resolution, o.ndt_outlier_ratio, d1, d2);
+    ndt_score_constants(o.voxel_resolution, o.ndt_outlier_ratio, d1, d2);
     return optimize(NdtFactor{source, map, neighbours, d1, d2}, initial, o.solver);
   }
   return optimize(CtfFineFactor{source, map, neighbours}, initial, o.solver);

@@ -36,6 +36,11 @@ RegistrationResult register_clouds(const PointCloud& source, const PointCloud& t
                                    const Pose& initial = Pose::Identity());
 
 std::vector<std::string> registration_method_names();
+
+/// Magnusson's NDT score constants d1, d2: the Gaussian fitted to a mixture of a normal and a
+/// uniform outlier distribution, for voxel size `resolution` (m) and outlier probability
+/// `outlier_ratio`.
+void ndt_score_constants(double resolution, double outlier_ratio, double& d1, double& d2);
 /// Points a cloud needs for the method (neighbourhoods, a determined system).
 std::size_t minimum_points(const std::string& method, const RegistrationOptions& options);
 

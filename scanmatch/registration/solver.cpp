@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
@@ -48,6 +49,28 @@ void finish_result(RegistrationResult& result, const LinearSystem& system) {
   const double smallest = result.eigenvalues(0), largest = result.eigenvalues(5);
   result.condition_number =
       smallest > 0.0 ? largest / smallest : std::numeric_limits<double>::infinity();
+}
+
+Degeneracy analyse_degeneracy(const Matrix6d& H, double range, double ratio) {
+  Degeneracy result;
+  Vector6d scale;  // u = D delta: rotations as displacements at `range`
+  scale << range, range, range, 1.0, 1.0, 1.0;
+  const Matrix6d scaled = scale.cwiseInverse().asDiagonal() * H * scale.cwiseInverse().asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Matrix6d> solver(scaled);
+  const double largest = solver.eigenvalues()(5);
+  if (!(largest > 0.0) || !std::isfinite(largest)) return result;
+  result.scaled_eigenvalues = solver.eigenvalues() / largest;
+  Matrix6d keep = Matrix6d::Zero();
+  for (int i = 0; i < 6; ++i) {
+    if (result.scaled_eigenvalues(i) < ratio) {
+      ++result.directions;
+      continue;
+    }
+    keep += solver.eigenvectors().col(i) * solver.eigenvectors().col(i).transpose();
+  }
+  if (result.directions > 0)
+    result.projector = scale.cwiseInverse().asDiagonal() * keep * scale.asDiagonal();
+  return result;
 }
 
 std::string RegistrationResult::summary() const {

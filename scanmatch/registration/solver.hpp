@@ -131,7 +131,24 @@ struct SolverOptions {
   double initial_lambda = 1e-6;
   RobustKernel kernel;
   int num_threads = 1;  ///< 1: single-threaded reduction; > 1: TBB with that many threads
+  /// Degeneracy guard (Zhang et al.'s solution remapping): directions of the information matrix
+  /// whose eigenvalue is below this fraction of the largest get no update, so they keep the
+  /// initial guess. 0 turns it off. See analyse_degeneracy for the scaling.
+  double degeneracy_ratio = 0.0;
+  double degeneracy_range = 10.0;  ///< m: a rotation counts as the displacement at this range
 };
+
+/// Which directions of an information matrix H (tangent order [rotation; translation]) are
+/// degenerate. Rotations are scaled to displacements at `range` metres so that both kinds compare;
+/// a direction is degenerate when its scaled eigenvalue is below `ratio` times the largest.
+struct Degeneracy {
+  int directions = 0;                              ///< number of degenerate directions
+  Vector6d scaled_eigenvalues = Vector6d::Zero();  ///< ascending, divided by the largest
+  /// Projects a tangent vector onto the well-constrained directions (identity when none is
+  /// degenerate).
+  Matrix6d projector = Matrix6d::Identity();
+};
+Degeneracy analyse_degeneracy(const Matrix6d& H, double range, double ratio);
 
 struct RegistrationResult {
   Pose transform = Pose::Identity();  ///< maps source coordinates into the target frame
@@ -184,7 +201,11 @@ RegistrationResult optimize(const Factor& factor, const Pose& initial,
     }
     Matrix6d H = system.H;
     if (options.levenberg_marquardt) H.diagonal() += lambda * (Vector6d::Ones() + H.diagonal());
-    const Vector6d delta = H.ldlt().solve(-system.b);
+    Vector6d delta = H.ldlt().solve(-system.b);
+    if (options.degeneracy_ratio > 0.0)
+      delta = analyse_degeneracy(system.H, options.degeneracy_range, options.degeneracy_ratio)
+                  .projector *
+              delta;
     if (!delta.allFinite()) {
       result.stop_reason = "singular system";
       break;
