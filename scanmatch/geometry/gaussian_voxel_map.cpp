@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 
 #include "scanmatch/core/error.hpp"
 
@@ -21,8 +22,39 @@ VoxelIndex GaussianVoxelMap::index_of(const Eigen::Vector3d& p) const {
 }
 
 const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {
-  const auto it = voxels_.find(index_of(p));
-  return it != voxels_.end() && it->second.count >= options_.min_points ? &it->second : nullptr;
+  const std::int32_t slot = lookup(index_of(p));
+  if (slot < 0) return nullptr;
+  const GaussianVoxel& v = voxels_[static_cast<std::size_t>(slot)];
+  return v.count >= options_.min_points ? &v : nullptr;
+}
+
+void GaussianVoxelMap::rebuild_table(std::size_t capacity) {
+  std::size_t size = 16;
+  while (size < 2 * capacity) size *= 2;
+  table_.assign(size, -1);
+  const std::size_t mask = size - 1;
+  for (std::size_t i = 0; i < indices_.size(); ++i) {
+    std::size_t slot = VoxelIndexHash{}(indices_[i]) & mask;
+    while (table_[slot] >= 0) slot = (slot + 1) & mask;
+    table_[slot] = static_cast<std::int32_t>(i);
+  }
+}
+
+std::size_t GaussianVoxelMap::lookup_or_create(const VoxelIndex& index) {
+  if (2 * (voxels_.size() + 1) > table_.size()) rebuild_table(2 * (voxels_.size() + 1));
+  const std::size_t mask = table_.size() - 1;
+  std::size_t slot = VoxelIndexHash{}(index)&mask;
+  for (;; slot = (slot + 1) & mask) {
+    const std::int32_t at = table_[slot];
+    if (at < 0) break;
+    if (indices_[static_cast<std::size_t>(at)] == index) return static_cast<std::size_t>(at);
+  }
+  if (voxels_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    throw Error("Gaussian voxel map: too many voxels");
+  table_[slot] = static_cast<std::int32_t>(voxels_.size());
+  voxels_.emplace_back();
+  indices_.push_back(index);
+  return voxels_.size() - 1;
 }
 
 const std::vector<std::array<int, 3>>& GaussianVoxelMap::offsets(int neighbours) {
@@ -83,30 +115,31 @@ void GaussianVoxelMap::merge_pending(const VoxelIndex& index, GaussianVoxel& v) 
 }
 
 std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) {
-  std::vector<VoxelIndex> touched;
+  std::vector<std::size_t> touched;
   touched.reserve(cloud.size() / 4 + 1);
   const std::uint64_t call = ++insert_calls_;
   for (const Point& point : cloud.points) {
     const Eigen::Vector3d p = pose * point.cast<double>();
     if (!p.allFinite()) continue;
     const VoxelIndex index = index_of(p);
-    GaussianVoxel& v = voxels_[index];
+    const std::size_t at = lookup_or_create(index);
+    GaussianVoxel& v = voxels_[at];
     if (options_.max_points > 0 && v.count >= options_.max_points) continue;
     const Eigen::Vector3d local =
         p - Eigen::Vector3d(index.x, index.y, index.z) * options_.voxel_size;
     if (v.last_insert != call) {
       v.last_insert = call;
-      touched.push_back(index);
+      touched.push_back(at);
     }
     ++v.pending;
     v.pending_sum += local;
     v.pending_outer += local * local.transpose();
   }
   std::size_t merged = 0;
-  for (const VoxelIndex& index : touched) {
-    GaussianVoxel& v = voxels_[index];
+  for (const std::size_t at : touched) {
+    GaussianVoxel& v = voxels_[at];
     if (v.pending >= options_.merge_threshold) {
-      merge_pending(index, v);
+      merge_pending(indices_[at], v);
       ++merged;
     }
   }
@@ -114,24 +147,31 @@ std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) 
 }
 
 void GaussianVoxelMap::flush() {
-  for (auto& [index, voxel] : voxels_) merge_pending(index, voxel);
+  for (std::size_t i = 0; i < voxels_.size(); ++i) merge_pending(indices_[i], voxels_[i]);
 }
 
 std::size_t GaussianVoxelMap::remove_far(const Eigen::Vector3d& center, double radius) {
   const double r2 = radius * radius;
-  std::size_t removed = 0;
-  for (auto it = voxels_.begin(); it != voxels_.end();) {
-    const Eigen::Vector3d where = it->second.count > 0
-                                      ? it->second.mean
-                                      : (Eigen::Vector3d(it->first.x, it->first.y, it->first.z) +
-                                         Eigen::Vector3d::Constant(0.5)) *
-                                            options_.voxel_size;
-    if ((where - center).squaredNorm() > r2) {
-      it = voxels_.erase(it);
-      ++removed;
-    } else {
-      ++it;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < voxels_.size(); ++i) {
+    const GaussianVoxel& v = voxels_[i];
+    const VoxelIndex& k = indices_[i];
+    const Eigen::Vector3d where =
+        v.count > 0 ? v.mean
+                    : (Eigen::Vector3d(k.x, k.y, k.z) + Eigen::Vector3d::Constant(0.5)) *
+                          options_.voxel_size;
+    if ((where - center).squaredNorm() > r2) continue;
+    if (kept != i) {
+      voxels_[kept] = std::move(voxels_[i]);
+      indices_[kept] = indices_[i];
     }
+    ++kept;
+  }
+  const std::size_t removed = voxels_.size() - kept;
+  if (removed > 0) {
+    voxels_.resize(kept);
+    indices_.resize(kept);
+    rebuild_table(kept);
   }
   return removed;
 }

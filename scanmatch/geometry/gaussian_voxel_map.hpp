@@ -7,7 +7,6 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
@@ -21,24 +20,32 @@ struct VoxelIndex {
 };
 struct VoxelIndexHash {
   std::size_t operator()(const VoxelIndex& v) const {
-    return (static_cast<std::size_t>(v.x) * 73856093u) ^
-           (static_cast<std::size_t>(v.y) * 19349669u) ^
-           (static_cast<std::size_t>(v.z) * 83492791u);
+    // Multiply-xor of the three coordinates, then a final avalanche so that the low bits (the
+    // open-addressing slot) depend on every coordinate bit.
+    std::uint64_t h =
+        static_cast<std::uint64_t>(static_cast<std::uint32_t>(v.x)) * 0x9E3779B97F4A7C15ull;
+    h ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(v.y)) * 0xC2B2AE3D27D4EB4Full;
+    h ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(v.z)) * 0x165667B19E3779F9ull;
+    h ^= h >> 29;
+    h *= 0xBF58476D1CE4E5B9ull;
+    return static_cast<std::size_t>(h ^ (h >> 32));
   }
 };
 
 struct GaussianVoxel {
+  // Hot: what registration reads per point (first cache lines).
   std::uint32_t count = 0;  ///< points merged into the Gaussian
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< population covariance
-  /// Cached from the covariance after each merge:
-  Eigen::Matrix3d planar_information = Eigen::Matrix3d::Identity();  ///< (Q diag(1,1,eps) Q^T)^-1
-  Eigen::Matrix3d regularized_covariance =
-      Eigen::Matrix3d::Identity();  ///< eigenvalues >= 1e-3 max
-  Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
   /// Smallest over middle eigenvalue: near 0 for a plane, up to 1 for a blob or a corner.
   float flatness = 1.0f;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  /// Cached from the covariance after each merge:
+  Eigen::Matrix3d planar_information = Eigen::Matrix3d::Identity();  ///< (Q diag(1,1,eps) Q^T)^-1
+  Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d regularized_covariance =
+      Eigen::Matrix3d::Identity();                    ///< eigenvalues >= 1e-3 max
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
+  // Cold: the statistics and the points waiting to be merged.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< population covariance
   /// Points waiting to be merged (sums relative to the voxel's corner for precision).
   std::uint32_t pending = 0;
   std::uint64_t last_insert = 0;  ///< which insert() call last touched the voxel
@@ -77,16 +84,17 @@ class GaussianVoxelMap {
   void for_each_neighbour(const Eigen::Vector3d& p, int neighbours, F&& f) const {
     const VoxelIndex c = index_of(p);
     for (const auto& o : offsets(neighbours)) {
-      const auto it = voxels_.find(VoxelIndex{c.x + o[0], c.y + o[1], c.z + o[2]});
-      if (it != voxels_.end() && it->second.count >= options_.min_points) f(it->second);
+      const std::int32_t slot = lookup(VoxelIndex{c.x + o[0], c.y + o[1], c.z + o[2]});
+      if (slot >= 0 && voxels_[static_cast<std::size_t>(slot)].count >= options_.min_points)
+        f(voxels_[static_cast<std::size_t>(slot)]);
     }
   }
 
   std::size_t size() const { return voxels_.size(); }
   const GaussianVoxelMapOptions& options() const { return options_; }
-  const std::unordered_map<VoxelIndex, GaussianVoxel, VoxelIndexHash>& voxels() const {
-    return voxels_;
-  }
+  /// Every voxel (usable or not) and its index, in parallel, in no particular order.
+  const std::vector<GaussianVoxel>& voxels() const { return voxels_; }
+  const std::vector<VoxelIndex>& indices() const { return indices_; }
 
   /// The merge of METHODS.md: (m, mu1, C1) + (n, mu2, C2) with the outer-product cross term.
   static void merge(GaussianVoxel& voxel, std::uint32_t n, const Eigen::Vector3d& mean,
@@ -96,9 +104,26 @@ class GaussianVoxelMap {
   static const std::vector<std::array<int, 3>>& offsets(int neighbours);
   void merge_pending(const VoxelIndex& index, GaussianVoxel& voxel);
   void update_cache(GaussianVoxel& voxel) const;
+  /// Position of the voxel in voxels_, or -1.
+  std::int32_t lookup(const VoxelIndex& index) const {
+    if (table_.empty()) return -1;
+    const std::size_t mask = table_.size() - 1;
+    for (std::size_t slot = VoxelIndexHash{}(index)&mask;; slot = (slot + 1) & mask) {
+      const std::int32_t at = table_[slot];
+      if (at < 0 || indices_[static_cast<std::size_t>(at)] == index) return at;
+    }
+  }
+  /// Position of the voxel, created when absent.
+  std::size_t lookup_or_create(const VoxelIndex& index);
+  void rebuild_table(std::size_t capacity);
+
   GaussianVoxelMapOptions options_;
   std::uint64_t insert_calls_ = 0;
-  std::unordered_map<VoxelIndex, GaussianVoxel, VoxelIndexHash> voxels_;
+  // Open addressing with linear probing: table_ holds positions into the dense arrays (-1: empty),
+  // at most half full. Dense storage keeps iteration and removal cheap.
+  std::vector<GaussianVoxel> voxels_;
+  std::vector<VoxelIndex> indices_;
+  std::vector<std::int32_t> table_;
 };
 
 }  // namespace scanmatch

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
@@ -57,13 +55,16 @@ void check_config(const OdometryConfig& c) {
   if (c.threads < 1) throw Error("odometry: threads must be at least 1");
 }
 
-// Deskewing with the constant-velocity motion over the frame: the transform at each of `bins`
-// instants is exact; between them a first-order step (I + ds xi^) is accurate to O(ds^2 |w|^2).
+// Deskewing with the constant-velocity motion over the frame, into the sensor frame at the
+// reference time `reference` (s after the frame start). The transform at each of `bins` instants is
+// exact; between them a first-order step (I + ds xi^) is accurate to O(ds^2 |w|^2).
 class FrameMotion {
  public:
-  FrameMotion(const Pose& motion, double period, double max_time) : xi_(se3_log(motion) / period) {
+  FrameMotion(const Pose& motion, double period, double max_time, double reference)
+      : xi_(se3_log(motion) / period) {
     step_ = std::max(max_time, 1e-6) / (kBins - 1);
-    for (int k = 0; k < kBins; ++k) bins_[k] = se3_exp(xi_ * (k * step_)).matrix().cast<float>();
+    for (int k = 0; k < kBins; ++k)
+      bins_[k] = se3_exp(xi_ * (k * step_ - reference)).matrix().cast<float>();
   }
   Point apply(const Point& p, float t) const {
     const int k = std::clamp(static_cast<int>(std::lround(t / step_)), 0, kBins - 1);
@@ -99,7 +100,7 @@ PointCloud Odometry::preprocess(const PointCloud& frame) const {
   if (deskew)
     for (float t : frame.time)
       if (std::isfinite(t)) max_time = std::max(max_time, t);
-  const FrameMotion motion(velocity_, frame_period_, max_time);
+  const FrameMotion motion(velocity_, frame_period_, max_time, 0.5 * frame_period_);
   PointCloud kept;
   kept.reserve(frame.size());
   for (std::size_t i = 0; i < frame.size(); ++i) {
@@ -160,11 +161,17 @@ Pose Odometry::register_ctf(const PointCloud& down, const Pose& predicted) {
   if (config_.fine_stage && map_.size() > 0) {
     const auto fine_start = Clock::now();
     CtfFineOptions fine_options;
-    fine_options.max_associations = config_.fine_max_iterations;
+    fine_options.max_iterations = config_.fine_max_iterations;
+    fine_options.tolerance = config_.fine_tolerance;
     fine_options.max_flatness = static_cast<float>(config_.fine_max_flatness);
     SolverOptions& solver = fine_options.solver;
     solver = config_.registration.solver;
     solver.degeneracy_ratio = config_.degeneracy_ratio;
+    // Rotations count as the displacement they cause at the frame's own RMS range: a fixed lever
+    // would call a narrow corridor's well-constrained roll degenerate.
+    double sum_r2 = 0.0;
+    for (const Point& p : down.points) sum_r2 += p.squaredNorm();
+    solver.degeneracy_range = std::max(std::sqrt(sum_r2 / static_cast<double>(down.size())), 0.1);
     solver.kernel = RobustKernel{};
     if (config_.fine_kernel_distance > 0.0) {
       // The residual is weighted by 1/eps along the normal: scale the kernel to match.
@@ -173,19 +180,11 @@ Pose Odometry::register_ctf(const PointCloud& down, const Pose& predicted) {
           config_.fine_kernel_distance / std::sqrt(config_.registration.ctf_epsilon);
     }
     const RegistrationResult fine = register_ctf_fine(down, map_, estimate, fine_options);
-    if (std::getenv("SCANMATCH_TRACE_FINE"))
-      std::fprintf(stderr, "fine: %s; start->end %.5f m, %d it\n", fine.stop_reason.c_str(),
-                   (estimate.inverse() * fine.transform).translation().norm(), fine.iterations);
     if (fine.inliers >= kMinimumPoints) {
       estimate = fine.transform;
-      if (config_.degeneracy_ratio > 0.0) {
-        // Along degenerate directions neither stage can be trusted: keep the motion prior there.
-        const Degeneracy d =
-            analyse_degeneracy(fine.information, solver.degeneracy_range, config_.degeneracy_ratio);
-        stats_.degenerate_directions = d.directions;
-        if (d.directions > 0)
-          estimate = predicted * se3_exp(d.projector * se3_log(predicted.inverse() * estimate));
-      }
+      stats_.degenerate_directions =
+          analyse_degeneracy(fine.information, solver.degeneracy_range, solver.degeneracy_ratio)
+              .directions;
     }
     stats_.fine_ms = ms_since(fine_start);
     stats_.iterations += fine.iterations;
@@ -198,6 +197,7 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   const auto start = Clock::now();
   stats_ = FrameStats{};
   stats_.points_in = frame.size();
+  if (frames_ == 0) timed_frames_ = frame.has_time();
   if (frames_ > 0 && timestamp > last_timestamp_) frame_period_ = timestamp - last_timestamp_;
   last_timestamp_ = timestamp;
   PointCloud down = frame.size() == frame.time.size() || frame.time.empty()
@@ -232,7 +232,11 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
     if (config_.map_update) {
       map_.insert(down, estimate);
       if (frames_ == 0) map_.flush();  // the first frame builds the map at once
-      map_.remove_far(estimate.translation(), config_.map_radius);
+      // Pruning scans the whole map: do it once the sensor has moved a tenth of the radius.
+      if ((estimate.translation() - last_prune_).norm() > 0.1 * config_.map_radius) {
+        map_.remove_far(estimate.translation(), config_.map_radius);
+        last_prune_ = estimate.translation();
+      }
     } else if (down.size() > 0) {
       // Ablation: the fine stage sees only the previous frame (no map building or update).
       map_ = GaussianVoxelMap(map_options(config_));
@@ -247,10 +251,16 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   if (!stats_.bridged && config_.constant_velocity)
     velocity_ = frames_ > 0 ? orthonormalized(pose_.inverse() * estimate) : Pose::Identity();
   pose_ = estimate;
+  // The registration estimated the pose at mid-frame (the deskew reference, and the average of a
+  // distorted frame's instants); the frame-start pose lies half the frame motion before it.
+  // Keeping the mid-frame pose as the state matters: deskewing to the frame start would shift a
+  // frame by half of any velocity error, and that error would feed back into the next velocity.
+  Pose reported = pose_;
+  if (timed_frames_ && frames_ > 0) reported = pose_ * se3_exp(-0.5 * se3_log(velocity_));
   if (!down.empty() || !stats_.bridged) previous_ = std::move(down);
   ++frames_;
   stats_.total_ms = ms_since(start);
-  return pose_;
+  return orthonormalized(reported);
 }
 
 }  // namespace scanmatch

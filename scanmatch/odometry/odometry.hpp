@@ -35,12 +35,14 @@ struct OdometryConfig {
   // Fine stage (ctf-icp): frame-to-map.
   double map_voxel_size = 0.5;        ///< m, the global Gaussian map
   std::uint32_t merge_threshold = 5;  ///< points pending before a map voxel is merged
-  double map_radius = 80.0;           ///< m, map voxels farther from the sensor are dropped
+  double map_radius = 80.0;  ///< m: map voxels farther from the sensor are dropped (checked
+                             ///< whenever the sensor has moved a tenth of it)
   /// Points a map voxel needs before the fine stage uses it.
   std::uint32_t map_voxel_min_points = 5;
   /// Points after which a map voxel is frozen (GaussianVoxelMapOptions::max_points; 0: never).
   std::uint32_t map_voxel_max_points = 0;
   int fine_max_iterations = 10;
+  double fine_tolerance = 1e-4;  ///< m and rad: the fine stage stops below this update
   /// Map voxels flatter than this (smallest / middle eigenvalue) are used; 1: all (the paper).
   double fine_max_flatness = 1.0;
   /// m: plane distance where the fine stage's Cauchy kernel starts to down-weight (0: no kernel)
@@ -101,10 +103,14 @@ class Odometry {
   GaussianVoxelMap map_;
   GaussianVoxelMap previous_ndt_;  ///< the previous frame's NDT grid, in its sensor frame
   PointCloud previous_;
-  Pose pose_ = Pose::Identity(), velocity_ = Pose::Identity();  ///< velocity_: last frame's motion
+  /// pose_: mid-frame pose of the last frame (frame start when frames carry no point times);
+  /// velocity_: motion between the last two such poses.
+  Pose pose_ = Pose::Identity(), velocity_ = Pose::Identity();
   double last_timestamp_ = 0.0, frame_period_ = 0.1;
   double ndt_d1_ = 0.0, ndt_d2_ = 0.0;
+  Eigen::Vector3d last_prune_ = Eigen::Vector3d::Zero();  ///< where the map was last pruned
   std::size_t frames_ = 0;
+  bool timed_frames_ = false;  ///< the first frame had point times: poses are mid-frame internally
   FrameStats stats_;
 };
 

@@ -1,61 +1,42 @@
 #include "scanmatch/registration/ctf_fine.hpp"
 
+#include "scanmatch/registration/factors.hpp"
+
 namespace scanmatch {
-namespace {
-
-// The planar-Gaussian residual of CtfFineFactor with the voxel of each point fixed.
-struct AssociatedPlanarFactor {
-  const PointCloud& source;
-  const std::vector<const GaussianVoxel*>& voxels;
-  std::size_t size() const { return source.size(); }
-  bool linearize(const Pose& T, std::size_t i, LinearSystem& system,
-                 const RobustKernel& kernel) const {
-    const GaussianVoxel* v = voxels[i];
-    if (!v) return false;
-    const Eigen::Vector3d p = source.points[i].cast<double>();
-    system.add<3>(point_jacobian(T, p), T * p - v->mean, v->planar_information, kernel);
-    return true;
-  }
-};
-
-}  // namespace
 
 RegistrationResult register_ctf_fine(const PointCloud& source, const GaussianVoxelMap& map,
                                      const Pose& initial, const CtfFineOptions& options) {
-  std::vector<const GaussianVoxel*> voxels(source.size(), nullptr);
-  SolverOptions inner = options.solver;
-  inner.max_iterations = options.gauss_newton_steps;
-  inner.levenberg_marquardt = false;
+  const CtfFineFactor factor{source, map, 1, options.max_flatness};
+  const SolverOptions& solver = options.solver;
   RegistrationResult result;
-  result.transform = initial;
-  result.stop_reason = "association limit";
-  int iterations = 0;
-  for (int association = 0; association < options.max_associations; ++association) {
-    for (std::size_t i = 0; i < source.size(); ++i) {
-      const GaussianVoxel* v = map.find(result.transform * source.points[i].cast<double>());
-      voxels[i] = v && v->flatness <= options.max_flatness ? v : nullptr;
-    }
-    const Pose before = result.transform;
-    RegistrationResult step = optimize(AssociatedPlanarFactor{source, voxels}, before, inner);
-    iterations += step.iterations;
-    if (step.inliers < 6) {
-      result = std::move(step);
-      result.transform = before;
-      result.iterations = iterations;
-      result.converged = false;
-      return result;
-    }
-    result = std::move(step);
-    const Pose change = before.inverse() * result.transform;
-    if (rotation_angle(change) < options.tolerance &&
-        change.translation().norm() < options.tolerance) {
-      result.converged = true;
-      result.stop_reason = "pose change below tolerance";
+  result.stop_reason = "iteration limit";
+  Pose T = initial;
+  LinearSystem system;
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    system = linearize_all(factor, T, solver);
+    result.iterations = iteration + 1;
+    if (system.inliers < 6) {
+      result.stop_reason = "too few correspondences (" + std::to_string(system.inliers) + ")";
       break;
     }
-    result.stop_reason = "association limit";
+    Vector6d delta = system.H.ldlt().solve(-system.b);
+    if (solver.degeneracy_ratio > 0.0)
+      delta =
+          analyse_degeneracy(system.H, solver.degeneracy_range, solver.degeneracy_ratio).projector *
+          delta;
+    if (!delta.allFinite()) {
+      result.stop_reason = "singular system";
+      break;
+    }
+    T = orthonormalized(T * se3_exp(delta));
+    if (delta.head<3>().norm() < options.tolerance && delta.tail<3>().norm() < options.tolerance) {
+      result.converged = true;
+      result.stop_reason = "update below tolerance";
+      break;
+    }
   }
-  result.iterations = iterations;
+  result.transform = T;
+  finish_result(result, system);
   return result;
 }
 
