@@ -88,7 +88,10 @@ void GaussianVoxelMap::merge(GaussianVoxel& v, std::uint32_t n, const Eigen::Vec
 }
 
 void GaussianVoxelMap::update_cache(GaussianVoxel& v) const {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(v.covariance);
+  // Closed-form 3x3 eigen decomposition: several times faster than the iterative one, and accurate
+  // enough in double precision for normals and regularisation.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(v.covariance);
   const Eigen::Matrix3d& Q = solver.eigenvectors();  // ascending eigenvalues
   v.normal = Q.col(0);
   const Eigen::Vector3d& e = solver.eigenvalues();

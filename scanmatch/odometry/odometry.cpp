@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
@@ -90,12 +91,15 @@ Odometry::Odometry(const OdometryConfig& config)
                       ndt_d2_);
 }
 
+bool Odometry::moving(const Pose& motion, double factor) const {
+  return motion.translation().norm() >= factor * config_.deskew_min_translation ||
+         rotation_angle(motion) >= factor * config_.deskew_min_rotation;
+}
+
 PointCloud Odometry::preprocess(const PointCloud& frame) const {
   const double min2 = config_.min_range * config_.min_range,
                max2 = config_.max_range * config_.max_range;
-  const bool deskew = config_.deskew && frame.has_time() && frames_ > 1 &&
-                      (velocity_.translation().norm() >= config_.deskew_min_translation ||
-                       rotation_angle(velocity_) >= config_.deskew_min_rotation);
+  const bool deskew = config_.deskew && frame.has_time() && frames_ > 1 && moving(velocity_);
   float max_time = 0.0f;
   if (deskew)
     for (float t : frame.time)
@@ -131,7 +135,8 @@ Pose Odometry::register_baseline(const PointCloud& down, const Pose& predicted) 
   return pose_ * r.transform;
 }
 
-Pose Odometry::register_ctf(const PointCloud& down, const Pose& predicted) {
+Pose Odometry::register_ctf(const PointCloud& down, const PointCloud& coarse_source,
+                            const Pose& predicted) {
   constexpr std::size_t kMinimumPoints = 20;
   if (down.size() < kMinimumPoints) {
     stats_.bridged = true;
@@ -141,9 +146,6 @@ Pose Odometry::register_ctf(const PointCloud& down, const Pose& predicted) {
   const auto coarse_start = Clock::now();
   Pose estimate = predicted;
   if (previous_ndt_.size() > 0) {
-    const PointCloud coarse_source = config_.coarse_voxel_size > config_.voxel_size
-                                         ? voxel_downsample(down, config_.coarse_voxel_size)
-                                         : down;
     SolverOptions solver = config_.registration.solver;
     solver.max_iterations = config_.coarse_max_iterations;
     solver.rotation_tolerance = solver.translation_tolerance = 1e-4;
@@ -208,10 +210,16 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
 
   const Pose predicted = pose_ * velocity_;
   const bool ctf = config_.method == "ctf-icp";
+  // The NDT stage works on a sparser cloud: it only has to bring the fine stage into its basin.
+  const PointCloud coarse = ctf && config_.coarse_voxel_size > config_.voxel_size
+                                ? voxel_downsample(down, config_.coarse_voxel_size)
+                                : PointCloud{};
+  const PointCloud& coarse_cloud = coarse.empty() ? down : coarse;
   Pose estimate = predicted;
   if (frames_ > 0) {
     try {
-      estimate = ctf ? register_ctf(down, predicted) : register_baseline(down, predicted);
+      estimate =
+          ctf ? register_ctf(down, coarse_cloud, predicted) : register_baseline(down, predicted);
     } catch (const Error&) {
       stats_.bridged = true;  // too few points or correspondences: keep the motion prior
       estimate = predicted;
@@ -256,7 +264,16 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   // Keeping the mid-frame pose as the state matters: deskewing to the frame start would shift a
   // frame by half of any velocity error, and that error would feed back into the next velocity.
   Pose reported = pose_;
-  if (timed_frames_ && frames_ > 0) reported = pose_ * se3_exp(-0.5 * se3_log(velocity_));
+  if (timed_frames_ && frames_ > 0) {
+    reported = pose_ * se3_exp(-0.5 * se3_log(velocity_));
+    // The world is frame 0's start pose, which is known once the first motion is: half of it
+    // before frame 0's mid-frame pose (the internal origin).
+    // A first motion within a few times the deskew dead band is mostly the first registration's
+    // noise (a still start): anchoring by it would offset every later pose.
+    if (frames_ == 1 && moving(velocity_, 3.0))
+      world_from_internal_ = se3_exp(0.5 * se3_log(velocity_));
+    reported = world_from_internal_ * reported;
+  }
   if (!down.empty() || !stats_.bridged) previous_ = std::move(down);
   ++frames_;
   stats_.total_ms = ms_since(start);

@@ -30,8 +30,8 @@ struct OdometryConfig {
   // Coarse stage (ctf-icp): NDT against the previous frame.
   double ndt_resolution = 1.0;     ///< m, the NDT grid of the previous frame
   int ndt_neighbours = 1;          ///< voxels per point: 1, 7 or 27
-  double coarse_voxel_size = 0.5;  ///< m, further downsampling of the NDT source (0: none)
-  int coarse_max_iterations = 10;
+  double coarse_voxel_size = 0.7;  ///< m, further downsampling of the NDT source (0: none)
+  int coarse_max_iterations = 30;
   // Fine stage (ctf-icp): frame-to-map.
   double map_voxel_size = 0.5;        ///< m, the global Gaussian map
   std::uint32_t merge_threshold = 5;  ///< points pending before a map voxel is merged
@@ -62,8 +62,8 @@ struct OdometryConfig {
   /// noise back into the next pose (a still sensor then drifts).
   double deskew_min_translation = 0.01;  ///< m per frame
   double deskew_min_rotation = 0.002;    ///< rad per frame
-  double max_jump = 1.0;         ///< m: a result farther than this from the prior is rejected
-  double max_jump_angle = 0.35;  ///< rad: likewise for rotation
+  double max_jump = 1.0;        ///< m: a result farther than this from the prior is rejected
+  double max_jump_angle = 1.0;  ///< rad: likewise for rotation (hand-held motion turns fast)
   int threads = 1;
   RegistrationOptions registration;  ///< parameters of the frame-to-frame baselines
 };
@@ -86,17 +86,24 @@ class Odometry {
   /// start in the world frame of the first frame. Never throws for bad frames: an empty or
   /// unregistrable frame is bridged by the motion prior (last_stats().bridged).
   Pose register_frame(const PointCloud& frame, double timestamp);
-  /// The global Gaussian map (ctf-icp), in the world frame.
+  /// The global Gaussian map (ctf-icp), in the internal world frame: world_from_map() * x gives
+  /// the world frame of the returned poses (they differ by half of frame 0's motion when frames
+  /// carry point times, since the internal origin is frame 0's mid-frame pose).
   const GaussianVoxelMap& map() const { return map_; }
-  /// The last registered frame, downsampled and deskewed, in its sensor frame.
+  const Pose& world_from_map() const { return world_from_internal_; }
+  /// The last registered frame, downsampled and deskewed, in its sensor frame at mid-frame (the
+  /// frame start when frames carry no point times); last_internal_pose() places it in map().
   const PointCloud& last_frame() const { return previous_; }
+  const Pose& last_internal_pose() const { return pose_; }
   const FrameStats& last_stats() const { return stats_; }
   const OdometryConfig& config() const { return config_; }
   std::size_t frames() const { return frames_; }
 
  private:
   PointCloud preprocess(const PointCloud& frame) const;
-  Pose register_ctf(const PointCloud& down, const Pose& predicted);
+  /// Motion above `factor` times the deskew dead band.
+  bool moving(const Pose& motion, double factor = 1.0) const;
+  Pose register_ctf(const PointCloud& down, const PointCloud& coarse, const Pose& predicted);
   Pose register_baseline(const PointCloud& down, const Pose& predicted);
 
   OdometryConfig config_;
@@ -106,6 +113,7 @@ class Odometry {
   /// pose_: mid-frame pose of the last frame (frame start when frames carry no point times);
   /// velocity_: motion between the last two such poses.
   Pose pose_ = Pose::Identity(), velocity_ = Pose::Identity();
+  Pose world_from_internal_ = Pose::Identity();
   double last_timestamp_ = 0.0, frame_period_ = 0.1;
   double ndt_d1_ = 0.0, ndt_d2_ = 0.0;
   Eigen::Vector3d last_prune_ = Eigen::Vector3d::Zero();  ///< where the map was last pruned
