@@ -1,6 +1,11 @@
+// Odometry pipeline against the simulator's ground truth: every method, CTF-ICP's drift, a still
+// sensor, the corridor, deskewing, the bounded map, the paper's ablations and bad frames.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
+#include <limits>
+#include <map>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
@@ -10,45 +15,215 @@
 using namespace scanmatch;
 
 namespace {
-AteResult run(const std::string& method, const std::vector<PointCloud>& frames,
-              const std::vector<Pose>& truth, bool deskew = true) {
-  OdometryConfig config;
-  config.method = method;
-  config.deskew = deskew;
-  Odometry odometry(config);
-  std::vector<Pose> estimate;
-  for (std::size_t i = 0; i < frames.size(); ++i)
-    estimate.push_back(odometry.register_frame(frames[i], 0.1 * i));
-  return compute_ate(truth, estimate);
+
+bool sanitized() {
+  return std::getenv("SCANMATCH_SANITIZED") != nullptr;
 }
+
+struct Sequence {
+  std::vector<PointCloud> frames;
+  std::vector<double> times;
+  std::vector<Pose> truth;
+};
+
+// Simulated once per (preset, frames) for the whole test binary.
+const Sequence& simulated(const std::string& preset, std::size_t frames) {
+  static std::map<std::pair<std::string, std::size_t>, Sequence> cache;
+  auto& s = cache[{preset, frames}];
+  if (s.frames.empty()) {
+    sim::SimOptions o;
+    o.preset = preset;
+    o.frames = frames;
+    const sim::Simulator simulator(o);
+    for (std::size_t i = 0; i < simulator.size(); ++i) {
+      s.frames.push_back(simulator.frame(i));
+      s.times.push_back(simulator.frame_time(i));
+    }
+    s.truth = simulator.ground_truth().poses;
+  }
+  return s;
+}
+
+struct OdometryRun {
+  std::vector<Pose> poses;
+  AteResult ate;
+  std::size_t degenerate_frames = 0, bridged_frames = 0, max_map_voxels = 0;
+};
+
+OdometryRun run(const OdometryConfig& config, const Sequence& s, std::size_t frames = 0) {
+  const std::size_t n = frames > 0 ? std::min(frames, s.frames.size()) : s.frames.size();
+  Odometry odometry(config);
+  OdometryRun r;
+  for (std::size_t i = 0; i < n; ++i) {
+    r.poses.push_back(odometry.register_frame(s.frames[i], s.times[i]));
+    r.degenerate_frames += odometry.last_stats().degenerate_directions > 0;
+    r.bridged_frames += odometry.last_stats().bridged;
+  }
+  r.ate = compute_ate({s.truth.begin(), s.truth.begin() + static_cast<std::ptrdiff_t>(n)}, r.poses);
+  return r;
+}
+
+OdometryConfig with_method(const std::string& method) {
+  OdometryConfig c;
+  c.method = method;
+  return c;
+}
+
 }  // namespace
 
-TEST(Odometry, CtfIcpTracksAFastDriveBetterThanIcp) {
-  // 40 frames (17 m at 4.4 m/s; 20 under the sanitizers, which are ~10x slower) of
-  // dynamic-outdoor-fast with motion distortion, deskewed:
-  // CTF-ICP stays within 0.1 m (0.5 % of the path); plain ICP drifts more.
-  sim::SimOptions o;
-  o.preset = "dynamic-outdoor-fast";
-  o.frames = std::getenv("SCANMATCH_SANITIZED") ? 20 : 40;
-  const sim::Simulator s(o);
-  std::vector<PointCloud> frames;
-  for (std::size_t i = 0; i < s.size(); ++i) frames.push_back(s.frame(i));
-  const std::vector<Pose> truth = s.ground_truth().poses;
-  const AteResult ctf = run("ctf-icp", frames, truth);
-  const AteResult icp = run("icp", frames, truth);
-  EXPECT_LT(ctf.rmse, 0.1) << "ctf-icp";
-  EXPECT_LT(ctf.rmse, icp.rmse);
-  // Deskewing helps: without it the distorted frames bias the estimate.
-  EXPECT_LT(ctf.rmse, run("ctf-icp", frames, truth, false).rmse);
+TEST(Odometry, EveryMethodProducesAFullTrajectory) {
+  const Sequence& s = simulated("dynamic-outdoor-fast", sanitized() ? 8 : 20);
+  for (const std::string method :
+       {"ctf-icp", "icp", "ndt", "gicp", "vgicp", "loam", "point-to-plane", "point-to-line"}) {
+    const OdometryRun r = run(with_method(method), s);
+    ASSERT_EQ(r.poses.size(), s.frames.size()) << method;
+    for (const Pose& p : r.poses) ASSERT_TRUE(is_valid_pose(to_matrix(p), 1e-6)) << method;
+    // About 9 m of fast driving: every method must at least follow it.
+    EXPECT_LT(r.ate.rmse, 1.0) << method;
+  }
 }
 
-TEST(Odometry, EmptyFramesAreBridgedByTheMotionPrior) {
-  OdometryConfig config;
-  Odometry odometry(config);
-  PointCloud empty;
-  EXPECT_NO_THROW(odometry.register_frame(empty, 0.0));
-  EXPECT_NO_THROW(odometry.register_frame(empty, 0.1));
-  EXPECT_TRUE(odometry.last_stats().bridged);
-  config.method = "magic";
-  EXPECT_THROW(Odometry{config}, Error);
+TEST(Odometry, CtfIcpDriftOnAFastDriveIsBelowThePapersAndTheBaselines) {
+  // 150 frames (65 m) of dynamic-outdoor-fast, the paper's Dynamic-3 (CTF-ICP: 0.22 % of the
+  // path). We hold the prefix to 0.3 % (measured about 0.1 % over the whole 336 m).
+  const Sequence& s = simulated("dynamic-outdoor-fast", 300);
+  const std::size_t frames = sanitized() ? 30 : 150;
+  const OdometryRun ctf = run(with_method("ctf-icp"), s, frames);
+  EXPECT_EQ(ctf.bridged_frames, 0u);
+  if (!sanitized()) {
+    EXPECT_LT(ctf.ate.rmse_percent_of_path, 0.3);
+    for (const std::string method : {"icp", "ndt"})
+      EXPECT_LT(ctf.ate.rmse, run(with_method(method), s, frames).ate.rmse) << method;
+  } else {
+    EXPECT_LT(ctf.ate.rmse, 0.1);
+  }
+}
+
+TEST(Odometry, AblationsOfThePaperAreWorseThanTheFullMethod) {
+  const Sequence& s = simulated("dynamic-outdoor-fast", 300);
+  const std::size_t frames = sanitized() ? 40 : 300;
+  const OdometryRun full = run(with_method("ctf-icp"), s, frames);
+  OdometryConfig coarse_only = with_method("ctf-icp");
+  coarse_only.fine_stage = false;
+  OdometryConfig no_map = with_method("ctf-icp");
+  no_map.map_update = false;
+  EXPECT_LT(full.ate.rmse, run(coarse_only, s, frames).ate.rmse) << "--no-fine";
+  EXPECT_LT(full.ate.rmse, run(no_map, s, frames).ate.rmse) << "--no-map-update";
+}
+
+TEST(Odometry, AStillSensorStaysWithinOneCentimetre) {
+  // The paper's Static-2: ICP, NDT, GICP and VGICP drift while CTF-ICP stays near the origin.
+  const Sequence& s = simulated("static-outdoor", sanitized() ? 20 : 120);
+  const OdometryRun ctf = run(with_method("ctf-icp"), s);
+  EXPECT_LT(ctf.ate.final_drift, 0.01);
+  EXPECT_LT(ctf.ate.max, 0.015);
+}
+
+TEST(Odometry, TheCorridorIsReportedDegenerateAndDoesNotRuinTheTrajectory) {
+  if (sanitized()) GTEST_SKIP() << "750 frames are too slow under the sanitizers";
+  // dynamic-indoor reaches the plain 36 m corridor after about 575 frames.
+  const Sequence& s = simulated("dynamic-indoor", 750);
+  const OdometryRun guarded = run(with_method("ctf-icp"), s);
+  EXPECT_GT(guarded.degenerate_frames, 50u);
+  EXPECT_LT(guarded.ate.rmse_percent_of_path, 0.5);
+  EXPECT_LT((guarded.poses.back().translation() - s.truth.back().translation()).norm(), 0.3);
+}
+
+TEST(Odometry, DeskewingImprovesAFastRotatingHandHeldSequence) {
+  // handheld-fast turns at up to 270 deg/s: 27 deg within one frame.
+  const Sequence& s = simulated("handheld-fast", sanitized() ? 30 : 100);
+  OdometryConfig off = with_method("ctf-icp");
+  off.deskew = false;
+  const OdometryRun with = run(with_method("ctf-icp"), s), without = run(off, s);
+  EXPECT_LT(with.ate.rmse, without.ate.rmse);
+}
+
+TEST(Odometry, MapMemoryStaysFlatWithASmallRadius) {
+  const Sequence& s = simulated("dynamic-outdoor-fast", 300);
+  OdometryConfig c = with_method("ctf-icp");
+  c.map_radius = 15.0;
+  Odometry odometry(c);
+  const std::size_t frames = sanitized() ? 60 : 300;
+  std::size_t first_half = 0, second_half = 0;
+  for (std::size_t i = 0; i < frames; ++i) {
+    const Pose pose = odometry.register_frame(s.frames[i], s.times[i]);
+    (i < frames / 2 ? first_half : second_half) =
+        std::max(i < frames / 2 ? first_half : second_half, odometry.map().size());
+    if (i + 1 == frames) {
+      // Every voxel lies within the radius (plus the pruning interval) of the sensor.
+      const Eigen::Vector3d sensor = (odometry.world_from_map().inverse() * pose).translation();
+      for (const GaussianVoxel& v : odometry.map().voxels())
+        if (v.count > 0) {
+          EXPECT_LT((v.mean - sensor).norm(), 1.1 * c.map_radius + 1.0);
+        }
+    }
+  }
+  EXPECT_GT(first_half, 0u);
+  // The robot covers new ground all along; the map does not grow with it.
+  EXPECT_LT(second_half, 1.5 * first_half);
+}
+
+TEST(Odometry, TheFivePointRuleAndTheMergeMatchBatchStatistics) {
+  GaussianVoxelMapOptions options;
+  options.voxel_size = 10.0;
+  options.merge_threshold = 5;
+  GaussianVoxelMap map(options);
+  std::vector<Eigen::Vector3d> points = {{1, 2, 3}, {2, 1, 3.5}, {1.5, 1.5, 2}, {3, 2, 2.5},
+                                         {2, 3, 3}, {1, 1, 1},   {2.5, 2.5, 4}, {3, 3, 1}};
+  const auto cloud = [&](std::size_t from, std::size_t to) {
+    PointCloud c;
+    for (std::size_t i = from; i < to; ++i) c.points.push_back(points[i].cast<float>());
+    return c;
+  };
+  // Four single points: pending, no Gaussian yet.
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(map.insert(cloud(i, i + 1)), 0u);
+  EXPECT_EQ(map.voxels().front().count, 0u);
+  // The fifth merges all five.
+  EXPECT_EQ(map.insert(cloud(4, 5)), 1u);
+  EXPECT_EQ(map.voxels().front().count, 5u);
+  // Three more stay pending; a flush merges them with the covariance-merge rule.
+  EXPECT_EQ(map.insert(cloud(5, 8)), 0u);
+  EXPECT_EQ(map.voxels().front().count, 5u);
+  map.flush();
+  const GaussianVoxel& v = map.voxels().front();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += p / 8.0;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) covariance += (p - mean) * (p - mean).transpose() / 8.0;
+  EXPECT_EQ(v.count, 8u);
+  EXPECT_LT((v.mean - mean).norm(), 1e-9);
+  EXPECT_LT((v.covariance - covariance).norm(), 1e-9);
+}
+
+TEST(Odometry, BadFramesAreBridgedNeverFatal) {
+  Odometry odometry(OdometryConfig{});
+  const Sequence& s = simulated("dynamic-outdoor-fast", 20);
+  odometry.register_frame(s.frames[0], 0.0);
+  odometry.register_frame(s.frames[1], 0.1);
+  PointCloud empty, tiny, non_finite, inconsistent = s.frames[2];
+  for (int i = 0; i < 3; ++i) tiny.points.emplace_back(float(i), 1.0f, 0.0f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int i = 0; i < 1000; ++i) non_finite.points.emplace_back(nan, float(i), 0.0f);
+  inconsistent.time.resize(5);
+  double t = 0.2;
+  for (const PointCloud* frame : {&empty, &tiny, &non_finite, &inconsistent}) {
+    Pose pose;
+    EXPECT_NO_THROW(pose = odometry.register_frame(*frame, t));
+    EXPECT_TRUE(odometry.last_stats().bridged);
+    EXPECT_TRUE(is_valid_pose(to_matrix(pose), 1e-6));
+    t += 0.1;
+  }
+  // After the gap the next good frame registers again.
+  odometry.register_frame(s.frames[6], 0.6);
+  EXPECT_FALSE(odometry.last_stats().bridged);
+}
+
+TEST(Odometry, InvalidConfigurationsAreRejected) {
+  EXPECT_THROW(Odometry{with_method("magic")}, Error);
+  OdometryConfig c;
+  c.map_voxel_size = 0.0;
+  EXPECT_THROW(Odometry{c}, Error);
+  c = OdometryConfig{};
+  c.threads = 0;
+  EXPECT_THROW(Odometry{c}, Error);
 }

@@ -238,7 +238,11 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   if (ctf) {
     const auto map_start = Clock::now();
     if (config_.map_update) {
-      map_.insert(down, estimate);
+      // Points beyond the radius would be pruned anyway: keep them out so the bound is strict.
+      bool beyond = false;
+      const double r2 = config_.map_radius * config_.map_radius;
+      for (const Point& p : down.points) beyond = beyond || p.squaredNorm() > r2;
+      map_.insert(beyond ? crop_range(down, 0.0, config_.map_radius) : down, estimate);
       if (frames_ == 0) map_.flush();  // the first frame builds the map at once
       // Pruning scans the whole map: do it once the sensor has moved a tenth of the radius.
       if ((estimate.translation() - last_prune_).norm() > 0.1 * config_.map_radius) {
