@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   scanmatch::cli::add_map2d_command(app);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command that ended early on purpose (Ctrl-C: 130)
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const scanmatch::Error& e) {

@@ -115,6 +115,9 @@ PointCloud Odometry::preprocess(const PointCloud& frame) const {
       kept.points.push_back(motion.apply(p, frame.time[i]));
     else
       kept.points.push_back(p);
+    // Rings and intensities feed the feature methods (loam); times are used up by the deskew.
+    if (frame.has_ring()) kept.ring.push_back(frame.ring[i]);
+    if (frame.has_intensity()) kept.intensity.push_back(frame.intensity[i]);
   }
   return config_.voxel_size > 0.0 ? voxel_downsample(kept, config_.voxel_size) : kept;
 }
@@ -202,7 +205,7 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   if (frames_ == 0) timed_frames_ = frame.has_time();
   if (frames_ > 0 && timestamp > last_timestamp_) frame_period_ = timestamp - last_timestamp_;
   last_timestamp_ = timestamp;
-  PointCloud down = frame.size() == frame.time.size() || frame.time.empty()
+  PointCloud down = frame.fields_consistent()
                         ? preprocess(frame)
                         : PointCloud{};  // inconsistent fields: treated as an empty frame
   stats_.points_downsampled = down.size();

@@ -35,7 +35,7 @@ struct OdometryConfig {
   // Fine stage (ctf-icp): frame-to-map.
   double map_voxel_size = 0.5;        ///< m, the global Gaussian map
   std::uint32_t merge_threshold = 5;  ///< points pending before a map voxel is merged
-  double map_radius = 80.0;  ///< m: map voxels farther from the sensor are dropped (checked
+  double map_radius = 50.0;  ///< m: map voxels farther from the sensor are dropped (checked
                              ///< whenever the sensor has moved a tenth of it)
   /// Points a map voxel needs before the fine stage uses it.
   std::uint32_t map_voxel_min_points = 5;

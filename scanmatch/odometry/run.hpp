@@ -3,7 +3,8 @@
 //   poses.txt       KITTI rows, one per frame, sensor pose in the world frame of frame 0
 //   poses_tum.txt   the same poses as TUM rows (timestamp tx ty tz qx qy qz qw)
 //   timing.csv      per frame: index,timestamp,preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,
-//                   points_in,points_downsampled,iterations,condition_number,bridged
+//                   points_in,points_downsampled,iterations,condition_number,
+//                   degenerate_directions,bridged
 //   summary.json    method, options (the whole configuration), frames, mean and max ms per stage,
 //                   frames per second, whether the run was interrupted (written atomically at end)
 //   config.json     the OdometryConfig used (reloadable with --config)

@@ -1,0 +1,22 @@
+#pragma once
+// OdometryConfig as JSON: every run writes the configuration it used (RUNDIR/config.json) and
+// `--config FILE` loads one back, so any number can be reproduced. Keys are the field names of
+// OdometryConfig, with "registration" (RegistrationOptions), "registration.solver"
+// (SolverOptions) and "registration.loam" nested. A file may give any subset; unknown keys and
+// wrong types are errors naming the file and the key.
+
+#include <string>
+
+#include "scanmatch/odometry/odometry.hpp"
+
+namespace scanmatch {
+
+/// The whole configuration as pretty-printed JSON text.
+std::string odometry_config_to_json(const OdometryConfig& config);
+/// Applies the keys in `json_text` on top of `base`; `source` names the input in errors.
+OdometryConfig odometry_config_from_json(const std::string& json_text, const std::string& source,
+                                         const OdometryConfig& base = {});
+/// Reads a JSON configuration file on top of `base`.
+OdometryConfig read_odometry_config(const std::string& path, const OdometryConfig& base = {});
+
+}  // namespace scanmatch

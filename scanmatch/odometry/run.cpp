@@ -1,0 +1,212 @@
+#include "scanmatch/odometry/run.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <unordered_set>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/core/progress.hpp"
+#include "scanmatch/io/cloud_io.hpp"
+#include "scanmatch/io/file_util.hpp"
+#include "scanmatch/odometry/config_io.hpp"
+
+namespace scanmatch {
+namespace {
+
+// Appended and flushed a line at a time, like the trajectory writers.
+class CsvWriter {
+ public:
+  CsvWriter(const std::string& path, const std::string& header) : path_(path) {
+    file_ = std::fopen(path.c_str(), "w");
+    if (!file_) fail(path, "cannot open for writing");
+    line(header);
+  }
+  ~CsvWriter() {
+    if (file_) std::fclose(file_);
+  }
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+  void line(const std::string& text) {
+    if (std::fputs(text.c_str(), file_) < 0 || std::fputc('\n', file_) == EOF ||
+        std::fflush(file_) != 0)
+      fail(path_, "write failed");
+  }
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+};
+
+// The exported map: one point per cell of `voxel` metres, first come first kept, optionally only
+// near the sensor. Bounded by the area the run covered, not by the number of frames.
+class PointMap {
+ public:
+  explicit PointMap(double voxel) : voxel_(voxel) {}
+  void add(const PointCloud& cloud, const Pose& pose) {
+    for (const Point& p : cloud.points) {
+      const Eigen::Vector3d w = pose * p.cast<double>();
+      const Eigen::Vector3d s = (w / voxel_).array().floor();
+      const Key key{static_cast<std::int32_t>(s.x()), static_cast<std::int32_t>(s.y()),
+                    static_cast<std::int32_t>(s.z())};
+      if (cells_.insert(key).second) points_.push_back(w.cast<float>());
+    }
+  }
+  void keep_within(const Eigen::Vector3d& center, double radius) {
+    const double r2 = radius * radius;
+    std::vector<Point> kept;
+    cells_.clear();
+    for (const Point& p : points_) {
+      if ((p.cast<double>() - center).squaredNorm() > r2) continue;
+      const Eigen::Vector3d s = (p.cast<double>() / voxel_).array().floor();
+      cells_.insert(Key{static_cast<std::int32_t>(s.x()), static_cast<std::int32_t>(s.y()),
+                        static_cast<std::int32_t>(s.z())});
+      kept.push_back(p);
+    }
+    points_.swap(kept);
+  }
+  PointCloud cloud() const {
+    PointCloud c;
+    c.points = points_;
+    return c;
+  }
+
+ private:
+  struct Key {
+    std::int32_t x, y, z;
+    bool operator==(const Key&) const = default;
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      return (static_cast<std::size_t>(k.x) * 73856093u) ^
+             (static_cast<std::size_t>(k.y) * 19349669u) ^
+             (static_cast<std::size_t>(k.z) * 83492791u);
+    }
+  };
+  double voxel_;
+  std::unordered_set<Key, KeyHash> cells_;
+  std::vector<Point> points_;
+};
+
+StageStatistics statistics(const std::vector<FrameStats>& stats, double FrameStats::*field) {
+  StageStatistics s;
+  if (stats.empty()) return s;
+  for (const FrameStats& f : stats) {
+    s.mean_ms += f.*field;
+    s.max_ms = std::max(s.max_ms, f.*field);
+  }
+  s.mean_ms /= static_cast<double>(stats.size());
+  return s;
+}
+
+nlohmann::ordered_json stage_json(const StageStatistics& s) {
+  return {{"mean_ms", s.mean_ms}, {"max_ms", s.max_ms}};
+}
+
+}  // namespace
+
+RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
+                        const RunOptions& options) {
+  Odometry odometry(config);
+  RunSummary summary;
+  summary.method = config.method;
+  summary.source = source.describe();
+  const bool write = !options.out_dir.empty();
+  const std::string dir = options.out_dir;
+  if (options.write_map && options.map_format != "pcd" && options.map_format != "ply")
+    throw Error("map format must be pcd or ply (got '" + options.map_format + "')");
+  if (!(options.map_voxel_size > 0.0)) throw Error("map export voxel size must be positive");
+  std::unique_ptr<TrajectoryWriter> kitti, tum;
+  std::unique_ptr<CsvWriter> timing;
+  if (write) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) fail(dir, "cannot create the run folder: " + ec.message());
+    write_file_atomic(dir + "/config.json", odometry_config_to_json(config));
+    kitti = std::make_unique<TrajectoryWriter>(dir + "/poses.txt", TrajectoryFormat::kKitti);
+    tum = std::make_unique<TrajectoryWriter>(dir + "/poses_tum.txt", TrajectoryFormat::kTum);
+    timing = std::make_unique<CsvWriter>(
+        dir + "/timing.csv",
+        "index,timestamp,preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,points_in,"
+        "points_downsampled,iterations,condition_number,degenerate_directions,bridged");
+  }
+  const std::size_t total =
+      options.max_frames > 0 ? std::min(options.max_frames, source.size()) : source.size();
+  PointMap map(options.map_voxel_size);
+  ProgressReporter progress("odometry " + config.method, total, "frames", options.quiet);
+  Frame frame;
+  double pipeline_ms = 0.0;
+  while (summary.frames < total) {
+    if (options.stop && options.stop->load()) {
+      summary.interrupted = true;
+      break;
+    }
+    if (!source.next(frame)) break;
+    const Pose pose = odometry.register_frame(frame.cloud, frame.timestamp);
+    const FrameStats& s = odometry.last_stats();
+    pipeline_ms += s.total_ms;
+    if (s.bridged && summary.frames > 0) {
+      ++summary.bridged_frames;
+      if (!options.quiet)
+        std::fprintf(stderr, "odometry: frame %zu (%s): %s, bridged by the motion prior\n",
+                     summary.frames, frame.name.c_str(),
+                     s.points_downsampled < 20 ? "too few valid points" : "registration failed");
+    }
+    summary.poses.push_back(pose);
+    summary.timestamps.push_back(frame.timestamp);
+    summary.stats.push_back(s);
+    if (write) {
+      kitti->write(pose, frame.timestamp);
+      tum->write(pose, frame.timestamp);
+      timing->line(fmt::format("{},{:.6f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{},{},{},{:.6g},{},{}",
+                               summary.frames, frame.timestamp, s.preprocess_ms, s.coarse_ms,
+                               s.fine_ms, s.map_ms, s.total_ms, s.points_in, s.points_downsampled,
+                               s.iterations, s.condition_number, s.degenerate_directions,
+                               s.bridged ? 1 : 0));
+    }
+    if (options.write_map) {
+      map.add(odometry.last_frame(), odometry.world_from_map() * odometry.last_internal_pose());
+      if (options.map_export_radius > 0.0 && summary.frames % 50 == 0)
+        map.keep_within(pose.translation(), options.map_export_radius);
+    }
+    ++summary.frames;
+    progress.update(summary.frames);
+  }
+  progress.finish();
+  summary.preprocess = statistics(summary.stats, &FrameStats::preprocess_ms);
+  summary.coarse = statistics(summary.stats, &FrameStats::coarse_ms);
+  summary.fine = statistics(summary.stats, &FrameStats::fine_ms);
+  summary.map_update = statistics(summary.stats, &FrameStats::map_ms);
+  summary.total = statistics(summary.stats, &FrameStats::total_ms);
+  summary.frames_per_second = pipeline_ms > 0.0 ? 1000.0 * summary.frames / pipeline_ms : 0.0;
+
+  if (write) {
+    if (options.write_map) {
+      if (options.map_export_radius > 0.0 && !summary.poses.empty())
+        map.keep_within(summary.poses.back().translation(), options.map_export_radius);
+      write_cloud(dir + "/map." + options.map_format, map.cloud());
+    }
+    nlohmann::ordered_json j = {
+        {"method", summary.method},
+        {"source", summary.source},
+        {"frames", summary.frames},
+        {"bridged_frames", summary.bridged_frames},
+        {"interrupted", summary.interrupted},
+        {"frames_per_second", summary.frames_per_second},
+        {"threads", config.threads},
+        {"stages",
+         {{"preprocess", stage_json(summary.preprocess)},
+          {"coarse", stage_json(summary.coarse)},
+          {"fine", stage_json(summary.fine)},
+          {"map_update", stage_json(summary.map_update)},
+          {"total", stage_json(summary.total)}}},
+        {"options", nlohmann::ordered_json::parse(odometry_config_to_json(config))}};
+    write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");
+  }
+  return summary;
+}
+
+}  // namespace scanmatch
