@@ -1,0 +1,28 @@
+#pragma once
+// The HTML report: one self-contained file (inline SVG plots made by svg_plot.hpp, no scripts, no
+// network) comparing run folders of `scanmatch odometry` against a ground truth: a table of
+// accuracy and speed, a top view of every trajectory, position error over distance, per-stage
+// time per frame, and a side view of the map when a run saved one.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scanmatch/eval/run_folder.hpp"
+
+namespace scanmatch {
+
+struct ReportOptions {
+  std::string title = "scanmatch odometry report";
+  /// Extra HTML (already escaped) inserted after the title, e.g. the benchmark's tables.
+  std::string preamble_html;
+  std::size_t max_map_points = 8000;  ///< side view of the map, decimated
+};
+
+/// Renders the runs. `ground_truth` overrides the runs' own poses_gt.txt; runs without either are
+/// shown without errors. Throws Error for mismatched trajectory lengths.
+std::string render_report(const std::vector<RunFolder>& runs,
+                          const std::optional<Trajectory>& ground_truth,
+                          const ReportOptions& options = {});
+
+}  // namespace scanmatch
