@@ -1,0 +1,106 @@
+// The HTML report, the result tables and `scanmatch bench` end to end; the report's rendering
+// in headless Chromium when it is installed.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/eval/report.hpp"
+#include "scanmatch/eval/svg_plot.hpp"
+#include "scanmatch/eval/table.hpp"
+#include "test_helpers.hpp"
+
+using namespace scanmatch;
+using scanmatch::testing::run_cli;
+using scanmatch::testing::TempDir;
+
+namespace {
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+}  // namespace
+
+TEST(Report, SvgPlotMapsDataIntoTheFrame) {
+  SvgSeries line = make_series("a<b", "#123456", {{0, 0}, {10, 5}});
+  const std::string svg = svg_plot({line}, {"T", "x", "y", 400, 300, true});
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("a&lt;b"), std::string::npos);  // escaped legend
+  EXPECT_NE(svg.find("stroke=\"#123456\""), std::string::npos);
+  EXPECT_EQ(count(svg, "<path"), 1u);
+  // Empty input still gives a valid, empty frame.
+  EXPECT_NE(svg_plot({}, {}).find("</svg>"), std::string::npos);
+}
+
+TEST(Report, TablesRenderAsMarkdownCsvAndHtml) {
+  const ResultTable t{"ATE, %", "note", {"sequence", "a", "b"}, {{"s1", "0.1", "1,5"}}};
+  EXPECT_NE(to_markdown(t).find("| s1 | 0.1 | 1,5 |"), std::string::npos);
+  EXPECT_NE(to_csv(t).find("\"ATE, %\",s1,0.1,\"1,5\""), std::string::npos);
+  EXPECT_NE(to_html(t).find("<td>1,5</td>"), std::string::npos);
+}
+
+TEST(Report, OdometryRunsBecomeOneSelfContainedPage) {
+  TempDir dir;
+  for (const std::string method : {"ctf-icp", "ndt"})
+    ASSERT_EQ(run_cli("odometry sim:dynamic-outdoor-fast --frames 8 --quiet --save-map --method " +
+                      method + " --out " + dir.file(method))
+                  .status,
+              0);
+  const auto r = run_cli("report " + dir.file("ctf-icp") + " " + dir.file("ndt") + " --out " +
+                         dir.file("report.html"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string html = read_text(dir.file("report.html"));
+  // Top view, error over distance, stage times of both runs, the map from above and the side.
+  EXPECT_EQ(count(html, "<svg"), 6u);
+  EXPECT_NE(html.find("ground truth"), std::string::npos);
+  EXPECT_EQ(html.find("http://www.w3.org/2000/svg") != std::string::npos, true);
+  EXPECT_EQ(count(html, "<script"), 0u);  // nothing to fetch, nothing to run
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  // A folder that is not a run is refused by name.
+  const auto bad = run_cli("report " + dir.path().string() + " --out " + dir.file("x.html"));
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("not a run folder"), std::string::npos) << bad.output;
+
+  const std::string chromium = "/usr/bin/chromium";
+  if (!std::filesystem::exists(chromium))
+    GTEST_SKIP() << "chromium not installed (scripts/bootstrap --browser): rendering not checked";
+  const std::string dom = dir.file("dom.html");
+  const std::string command =
+      chromium +
+      " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+      "--disable-background-networking --disable-component-update --disable-sync "
+      "--user-data-dir=" +
+      dir.file("profile") + " --dump-dom file://" + dir.file("report.html") + " > " + dom +
+      " 2>/dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  const std::string rendered = read_text(dom);
+  EXPECT_EQ(count(rendered, "<svg"), 6u);
+  EXPECT_NE(rendered.find("Position error over distance"), std::string::npos);
+}
+
+TEST(Bench, OneRunGivesEveryTableForEveryMethod) {
+  TempDir dir;
+  const auto r = run_cli(
+      "bench --preset static-indoor --preset dynamic-outdoor-fast --frames 6 "
+      "--method ctf-icp --method ndt --quiet --out " +
+      dir.file("b"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string md = read_text(dir.file("b/tables.md"));
+  for (const std::string title : {"CTF-ICP Table 2", "CTF-ICP Table 3", "CTF-ICP Table 4",
+                                  "CTF-ICP Table 5", "Still sensor", "LOAM paper"})
+    EXPECT_NE(md.find(title), std::string::npos) << title;
+  EXPECT_NE(md.find("| dynamic-outdoor-fast |"), std::string::npos);
+  EXPECT_NE(read_text(dir.file("b/tables.csv")).find("static-indoor"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("b/report.html")));
+  EXPECT_TRUE(
+      std::filesystem::exists(dir.file("b/runs/dynamic-outdoor-fast/ctf-icp_--no-fine/poses.txt")));
+  const auto bad = run_cli("bench --method magic --out " + dir.file("c"));
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("magic"), std::string::npos);
+}
