@@ -15,5 +15,6 @@ void add_odometry_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_report_command(CLI::App& app);
 void add_map2d_command(CLI::App& app);
+void add_bench2d_command(CLI::App& app);
 
 }  // namespace scanmatch::cli

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   scanmatch::cli::add_bench_command(app);
   scanmatch::cli::add_report_command(app);
   scanmatch::cli::add_map2d_command(app);
+  scanmatch::cli::add_bench2d_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -100,8 +100,11 @@ TEST(Odometry, CtfIcpDriftOnAFastDriveIsBelowThePapersAndTheBaselines) {
 }
 
 TEST(Odometry, AblationsOfThePaperAreWorseThanTheFullMethod) {
+  // The ablations lose to the full method by drifting, which takes a long run to show: over the
+  // first 40 frames (all a sanitized build can afford) the three are within a few centimetres.
+  if (sanitized()) GTEST_SKIP() << "300 frames are too slow under the sanitizers";
   const Sequence& s = simulated("dynamic-outdoor-fast", 300);
-  const std::size_t frames = sanitized() ? 40 : 300;
+  const std::size_t frames = 300;
   const OdometryRun full = run(with_method("ctf-icp"), s, frames);
   OdometryConfig coarse_only = with_method("ctf-icp");
   coarse_only.fine_stage = false;

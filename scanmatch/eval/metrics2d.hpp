@@ -1,0 +1,27 @@
+#pragma once
+// Relative pose error of 2D trajectories over a fixed number of scan steps, as used for the
+// CARMEN logs, whose corrected poses are a reference for relative motion only.
+
+#include <cstddef>
+#include <vector>
+
+#include "scanmatch/registration/scan2d.hpp"
+
+namespace scanmatch {
+
+struct RelativeError2D {
+  std::size_t step = 1, pairs = 0;
+  double mean_translation = 0, median_translation = 0, max_translation = 0;  ///< m
+  double mean_rotation = 0, median_rotation = 0, max_rotation = 0;           ///< rad
+  /// Fraction of pairs off by more than the failure thresholds.
+  double failure_rate = 0;
+};
+
+/// Compares the motion from pose k to pose k + step of `estimate` with that of `reference`, for
+/// every k. Throws Error when the sizes differ.
+RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
+                                       const std::vector<Pose2>& estimate, std::size_t step,
+                                       double failure_translation = 0.2,
+                                       double failure_rotation = 5.0 * M_PI / 180);
+
+}  // namespace scanmatch

@@ -1,0 +1,111 @@
+#include "scanmatch/io/image.hpp"
+
+#include <zlib.h>
+
+#include <cstddef>
+#include <cstring>
+#include <limits>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/io/file_util.hpp"
+
+namespace scanmatch {
+namespace {
+
+constexpr std::size_t kIdatChunkBytes = std::size_t{1} << 20;
+
+// Validates the sizes and returns the number of bytes the image must have.
+std::size_t checked_byte_count(const std::string& path, int width, int height, int channels,
+                               std::size_t actual) {
+  if (width <= 0 || height <= 0)
+    fail(path, "image size must be positive, got " + std::to_string(width) + " x " +
+                   std::to_string(height));
+  const std::size_t expected =
+      static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * channels;
+  if (actual != expected)
+    fail(path, "expected " + std::to_string(expected) + " bytes for a " + std::to_string(width) +
+                   " x " + std::to_string(height) + " image with " + std::to_string(channels) +
+                   " channel(s), got " + std::to_string(actual));
+  return expected;
+}
+
+void append_u32_be(std::string& out, std::uint32_t value) {
+  out.push_back(static_cast<char>(value >> 24));
+  out.push_back(static_cast<char>(value >> 16));
+  out.push_back(static_cast<char>(value >> 8));
+  out.push_back(static_cast<char>(value));
+}
+
+// A PNG chunk: length, type, data, then the CRC of type and data.
+void append_chunk(std::string& out, const char (&type)[5], const std::string& data) {
+  append_u32_be(out, static_cast<std::uint32_t>(data.size()));
+  const std::size_t type_start = out.size();
+  out.append(type, 4);
+  out.append(data);
+  const uLong crc =
+      crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(out.data() + type_start),
+            static_cast<uInt>(4 + data.size()));
+  append_u32_be(out, static_cast<std::uint32_t>(crc));
+}
+
+void write_png_channels(const std::string& path, int width, int height, int channels,
+                        std::uint8_t colour_type, const std::vector<std::uint8_t>& pixels) {
+  checked_byte_count(path, width, height, channels, pixels.size());
+  const std::size_t row_bytes = static_cast<std::size_t>(width) * channels;
+  const std::size_t raw_size = static_cast<std::size_t>(height) * (row_bytes + 1);
+  if (raw_size > std::numeric_limits<uLong>::max() / 2)
+    fail(path, "image is too large for zlib (" + std::to_string(raw_size) + " bytes)");
+
+  // Every scanline starts with its filter type; 0 (none) keeps the encoder trivial.
+  std::string raw(raw_size, '\0');
+  for (int row = 0; row < height; ++row)
+    std::memcpy(raw.data() + row * (row_bytes + 1) + 1, pixels.data() + row * row_bytes, row_bytes);
+
+  uLongf compressed_size = compressBound(static_cast<uLong>(raw.size()));
+  std::string compressed(compressed_size, '\0');
+  if (compress2(reinterpret_cast<Bytef*>(compressed.data()), &compressed_size,
+                reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()),
+                Z_BEST_COMPRESSION) != Z_OK)
+    fail(path, "zlib compression failed");
+  compressed.resize(compressed_size);
+
+  std::string header;
+  append_u32_be(header, static_cast<std::uint32_t>(width));
+  append_u32_be(header, static_cast<std::uint32_t>(height));
+  header.push_back(8);                               // bit depth
+  header.push_back(static_cast<char>(colour_type));  // 0 grey, 2 RGB
+  header.push_back(0);                               // compression: deflate
+  header.push_back(0);                               // filter method: adaptive (per row)
+  header.push_back(0);                               // no interlace
+
+  std::string file("\x89PNG\r\n\x1a\n", 8);
+  append_chunk(file, "IHDR", header);
+  // The zlib stream may span several IDAT chunks (a chunk length is limited to 2^31 - 1); decoders
+  // concatenate them.
+  for (std::size_t start = 0; start < compressed.size(); start += kIdatChunkBytes)
+    append_chunk(file, "IDAT", compressed.substr(start, kIdatChunkBytes));
+  append_chunk(file, "IEND", std::string());
+  write_file_atomic(path, file);
+}
+
+}  // namespace
+
+void write_pgm(const std::string& path, int width, int height,
+               const std::vector<std::uint8_t>& pixels) {
+  checked_byte_count(path, width, height, 1, pixels.size());
+  std::string file = "P5\n" + std::to_string(width) + " " + std::to_string(height) + "\n255\n";
+  file.append(reinterpret_cast<const char*>(pixels.data()), pixels.size());
+  write_file_atomic(path, file);
+}
+
+void write_png(const std::string& path, int width, int height,
+               const std::vector<std::uint8_t>& pixels) {
+  write_png_channels(path, width, height, 1, 0, pixels);
+}
+
+void write_png_rgb(const std::string& path, int width, int height,
+                   const std::vector<std::uint8_t>& rgb) {
+  write_png_channels(path, width, height, 3, 2, rgb);
+}
+
+}  // namespace scanmatch

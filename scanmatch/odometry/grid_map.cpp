@@ -1,0 +1,334 @@
+#include "scanmatch/odometry/grid_map.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <utility>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/io/file_util.hpp"
+#include "scanmatch/io/image.hpp"
+
+namespace scanmatch {
+namespace {
+
+// Lattice indices stay well inside int so that extents and sums of them cannot overflow.
+constexpr double kMaxCellIndex = double{1 << 30};
+// Cells added on each side when the grid grows, so that a moving sensor does not reallocate the
+// grid on every scan.
+constexpr int kMinGrowthMargin = 64;
+constexpr float kUnobserved = std::numeric_limits<float>::quiet_NaN();
+
+double probability_of(double log_odds) {
+  return 1.0 / (1.0 + std::exp(-log_odds));
+}
+
+// Lattice cell containing `p` given in cell units (world / resolution); caller checks the range.
+Eigen::Vector2i floor_cell(const Eigen::Vector2d& p) {
+  return {static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y()))};
+}
+
+bool cell_index_in_range(const Eigen::Vector2d& p) {
+  return std::abs(p.x()) < kMaxCellIndex && std::abs(p.y()) < kMaxCellIndex;
+}
+
+// Calls visit(cell) for every cell the segment a -> b (in cell units) passes through, from a's
+// cell up to but excluding b's cell (Amanatides & Woo). The number of steps is fixed by the
+// integer distance between the end cells, so rounding can never overshoot the end cell.
+template <class Visit>
+void for_each_cell_before_end(const Eigen::Vector2d& a, const Eigen::Vector2d& b, Visit&& visit) {
+  Eigen::Vector2i cell = floor_cell(a);
+  const Eigen::Vector2i end = floor_cell(b);
+  const Eigen::Vector2d direction = b - a;
+  const Eigen::Vector2i step(end.x() >= cell.x() ? 1 : -1, end.y() >= cell.y() ? 1 : -1);
+  Eigen::Vector2i remaining((end - cell).cwiseAbs());
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  // Ray parameter (0 at a, 1 at b) of the next boundary crossed along each axis, and between two
+  // boundaries. An axis with steps remaining has a non-zero direction of the step's sign.
+  Eigen::Vector2d next_crossing(kNever, kNever);
+  Eigen::Vector2d crossing_interval(kNever, kNever);
+  for (int axis = 0; axis < 2; ++axis) {
+    if (remaining[axis] == 0) continue;
+    const double boundary = step[axis] > 0 ? cell[axis] + 1.0 : cell[axis];
+    next_crossing[axis] = (boundary - a[axis]) / direction[axis];
+    crossing_interval[axis] = 1.0 / std::abs(direction[axis]);
+  }
+  while (remaining.x() + remaining.y() > 0) {
+    visit(cell);
+    const int axis =
+        remaining.y() == 0 || (remaining.x() > 0 && next_crossing.x() < next_crossing.y()) ? 0 : 1;
+    cell[axis] += step[axis];
+    next_crossing[axis] += crossing_interval[axis];
+    --remaining[axis];
+  }
+}
+
+// Shortest text that reads back as the same (finite) double, with a decimal point so that YAML
+// 1.1 reads a float ("2.0", "1.0e-07").
+std::string yaml_number(double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  std::string text(buffer, result.ptr);
+  if (text.find('.') == std::string::npos) text.insert(std::min(text.find('e'), text.size()), ".0");
+  return text;
+}
+
+// A YAML scalar for a file name: plain when safe, double-quoted otherwise.
+std::string yaml_string(const std::string& text) {
+  const bool plain = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+  });
+  if (plain) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+OccupancyGrid::OccupancyGrid(const GridMapOptions& options) : options_(options) {
+  const auto require = [](bool ok, const std::string& problem) {
+    if (!ok) fail("grid map options", problem);
+  };
+  const GridMapOptions& o = options;
+  require(std::isfinite(o.resolution) && o.resolution > 0,
+          "resolution must be positive, got " + std::to_string(o.resolution));
+  require(std::isfinite(o.hit_log_odds) && o.hit_log_odds > 0,
+          "hit_log_odds must be positive, got " + std::to_string(o.hit_log_odds));
+  require(std::isfinite(o.miss_log_odds) && o.miss_log_odds < 0,
+          "miss_log_odds must be negative, got " + std::to_string(o.miss_log_odds));
+  require(std::isfinite(o.min_log_odds) && o.min_log_odds < 0,
+          "min_log_odds must be negative, got " + std::to_string(o.min_log_odds));
+  require(std::isfinite(o.max_log_odds) && o.max_log_odds > 0,
+          "max_log_odds must be positive, got " + std::to_string(o.max_log_odds));
+  require(
+      o.free_threshold > 0 && o.free_threshold < o.occupied_threshold && o.occupied_threshold < 1,
+      "thresholds must satisfy 0 < free_threshold < occupied_threshold < 1, got " +
+          std::to_string(o.free_threshold) + " and " + std::to_string(o.occupied_threshold));
+}
+
+void OccupancyGrid::insert_scan(const Eigen::Isometry2d& sensor_pose,
+                                const std::vector<Eigen::Vector2d>& hits_in_sensor_frame,
+                                const std::vector<Eigen::Vector2d>& misses_in_sensor_frame) {
+  if (!sensor_pose.matrix().allFinite()) return;
+  // Everything in cell units from here on, divided exactly as index_of divides, so that a query at
+  // a hit point finds the hit's cell even on a cell boundary.
+  const double resolution = options_.resolution;
+  const Eigen::Vector2d sensor = sensor_pose.translation() / resolution;
+  const auto check_range = [&](const Eigen::Vector2d& p) {
+    if (!cell_index_in_range(p))
+      fail("occupancy grid", "point (" + std::to_string(p.x() * resolution) + ", " +
+                                 std::to_string(p.y() * resolution) +
+                                 ") m is too far from the origin for the grid");
+  };
+  check_range(sensor);
+  const auto to_cells = [&](const std::vector<Eigen::Vector2d>& points) {
+    std::vector<Eigen::Vector2d> out;
+    out.reserve(points.size());
+    for (const Eigen::Vector2d& p : points) {
+      if (!p.allFinite()) continue;
+      out.push_back(sensor_pose * p / resolution);
+      check_range(out.back());
+    }
+    return out;
+  };
+  const std::vector<Eigen::Vector2d> hits = to_cells(hits_in_sensor_frame);
+  const std::vector<Eigen::Vector2d> misses = to_cells(misses_in_sensor_frame);
+  if (hits.empty() && misses.empty()) return;
+
+  // A ray never leaves the bounding box of its end cells, so one growth covers the whole scan.
+  Eigen::Vector2i low = floor_cell(sensor);
+  Eigen::Vector2i high = low;
+  for (const auto* points : {&hits, &misses})
+    for (const Eigen::Vector2d& p : *points) {
+      low = low.cwiseMin(floor_cell(p));
+      high = high.cwiseMax(floor_cell(p));
+    }
+  ensure_contains(low, high);
+
+  const auto storage_index = [&](const Eigen::Vector2i& cell) {
+    return static_cast<std::int64_t>(cell.y() - origin_cell_.y()) * width_ +
+           (cell.x() - origin_cell_.x());
+  };
+  std::vector<std::int64_t> hit_cells;
+  std::vector<std::int64_t> free_cells;
+  hit_cells.reserve(hits.size());
+  const auto add_free = [&](const Eigen::Vector2i& cell) {
+    free_cells.push_back(storage_index(cell));
+  };
+  for (const Eigen::Vector2d& hit : hits) {
+    for_each_cell_before_end(sensor, hit, add_free);
+    hit_cells.push_back(storage_index(floor_cell(hit)));
+  }
+  for (const Eigen::Vector2d& miss : misses) {
+    for_each_cell_before_end(sensor, miss, add_free);
+    add_free(floor_cell(miss));
+  }
+
+  // One update per cell and scan; hits win over misses.
+  std::sort(hit_cells.begin(), hit_cells.end());
+  hit_cells.erase(std::unique(hit_cells.begin(), hit_cells.end()), hit_cells.end());
+  std::sort(free_cells.begin(), free_cells.end());
+  free_cells.erase(std::unique(free_cells.begin(), free_cells.end()), free_cells.end());
+  const auto update = [&](std::int64_t index, double delta) {
+    float& cell = log_odds_[static_cast<std::size_t>(index)];
+    const double before = std::isnan(cell) ? 0.0 : cell;
+    cell = static_cast<float>(
+        std::clamp(before + delta, options_.min_log_odds, options_.max_log_odds));
+  };
+  auto hit_it = hit_cells.begin();
+  for (std::int64_t index : free_cells) {
+    while (hit_it != hit_cells.end() && *hit_it < index) ++hit_it;
+    if (hit_it != hit_cells.end() && *hit_it == index) continue;
+    update(index, options_.miss_log_odds);
+  }
+  for (std::int64_t index : hit_cells) update(index, options_.hit_log_odds);
+}
+
+void OccupancyGrid::ensure_contains(const Eigen::Vector2i& low, const Eigen::Vector2i& high) {
+  const bool empty = log_odds_.empty();
+  const Eigen::Vector2i old_low = origin_cell_;
+  const Eigen::Vector2i old_high = origin_cell_ + Eigen::Vector2i(width_ - 1, height_ - 1);
+  if (!empty && (low.array() >= old_low.array()).all() && (high.array() <= old_high.array()).all())
+    return;
+
+  // Union of the old and the needed rectangles, widened by `margin` on each side that grows.
+  const auto bounds = [&](const Eigen::Vector2i& margin) {
+    Eigen::Vector2i new_low = low - margin, new_high = high + margin;
+    if (!empty) {
+      for (int axis = 0; axis < 2; ++axis) {
+        new_low[axis] = low[axis] < old_low[axis] ? low[axis] - margin[axis] : old_low[axis];
+        new_high[axis] = high[axis] > old_high[axis] ? high[axis] + margin[axis] : old_high[axis];
+      }
+    }
+    return std::pair{new_low, new_high};
+  };
+  const auto cell_count = [](const std::pair<Eigen::Vector2i, Eigen::Vector2i>& b) {
+    return (static_cast<std::int64_t>(b.second.x()) - b.first.x() + 1) *
+           (static_cast<std::int64_t>(b.second.y()) - b.first.y() + 1);
+  };
+  // Growing by half the current size keeps the number of reallocations logarithmic.
+  const Eigen::Vector2i margin(std::max(kMinGrowthMargin, width_ / 2),
+                               std::max(kMinGrowthMargin, height_ / 2));
+  auto new_bounds = bounds(margin);
+  if (cell_count(new_bounds) > kMaxCells) new_bounds = bounds(Eigen::Vector2i::Zero());
+  if (cell_count(new_bounds) > kMaxCells)
+    fail("occupancy grid",
+         "covering the scan needs " + std::to_string(cell_count(new_bounds)) +
+             " cells, more than the limit of " + std::to_string(kMaxCells) +
+             " (a point far from the others, or a resolution too fine for the area)");
+
+  const auto& [new_low, new_high] = new_bounds;
+  const int new_width = new_high.x() - new_low.x() + 1;
+  const int new_height = new_high.y() - new_low.y() + 1;
+  std::vector<float> grown(static_cast<std::size_t>(new_width) * new_height, kUnobserved);
+  const Eigen::Vector2i shift = origin_cell_ - new_low;
+  for (int row = 0; row < height_; ++row)
+    std::copy_n(
+        log_odds_.begin() + static_cast<std::ptrdiff_t>(row) * width_, width_,
+        grown.begin() + static_cast<std::ptrdiff_t>(row + shift.y()) * new_width + shift.x());
+  log_odds_ = std::move(grown);
+  origin_cell_ = new_low;
+  width_ = new_width;
+  height_ = new_height;
+}
+
+std::int64_t OccupancyGrid::index_of(const Eigen::Vector2d& world) const {
+  const Eigen::Vector2d p = world / options_.resolution;
+  if (!p.allFinite() || !cell_index_in_range(p)) return -1;
+  const Eigen::Vector2i cell = floor_cell(p) - origin_cell_;
+  if (cell.x() < 0 || cell.y() < 0 || cell.x() >= width_ || cell.y() >= height_) return -1;
+  return static_cast<std::int64_t>(cell.y()) * width_ + cell.x();
+}
+
+double OccupancyGrid::probability(const Eigen::Vector2d& world) const {
+  const std::int64_t index = index_of(world);
+  if (index < 0) return 0.5;
+  const float log_odds = log_odds_[static_cast<std::size_t>(index)];
+  return std::isnan(log_odds) ? 0.5 : probability_of(log_odds);
+}
+
+bool OccupancyGrid::observed(const Eigen::Vector2d& world) const {
+  const std::int64_t index = index_of(world);
+  return index >= 0 && !std::isnan(log_odds_[static_cast<std::size_t>(index)]);
+}
+
+CellState OccupancyGrid::state(const Eigen::Vector2d& world) const {
+  const double p = probability(world);
+  if (p > options_.occupied_threshold) return CellState::kOccupied;
+  if (p < options_.free_threshold) return CellState::kFree;
+  return CellState::kUnknown;
+}
+
+Eigen::Vector2d OccupancyGrid::cell_centre(int column, int row) const {
+  return (origin_cell_.cast<double>() + Eigen::Vector2d(column + 0.5, row + 0.5)) *
+         options_.resolution;
+}
+
+std::vector<Eigen::Vector2d> OccupancyGrid::occupied_cell_centres() const {
+  std::vector<Eigen::Vector2d> centres;
+  for (int row = 0; row < height_; ++row)
+    for (int column = 0; column < width_; ++column) {
+      const float log_odds = log_odds_[static_cast<std::size_t>(row) * width_ + column];
+      if (!std::isnan(log_odds) && probability_of(log_odds) > options_.occupied_threshold)
+        centres.push_back(cell_centre(column, row));
+    }
+  return centres;
+}
+
+std::vector<std::uint8_t> OccupancyGrid::render() const {
+  std::vector<std::uint8_t> pixels(log_odds_.size(), kUnknownPixel);
+  for (int row = 0; row < height_; ++row) {
+    // Image rows run from the top (highest y) down; grid rows from the lowest y up.
+    const std::size_t image_row = static_cast<std::size_t>(height_ - 1 - row);
+    for (int column = 0; column < width_; ++column) {
+      const float log_odds = log_odds_[static_cast<std::size_t>(row) * width_ + column];
+      if (std::isnan(log_odds)) continue;
+      const double p = probability_of(log_odds);
+      std::uint8_t& pixel = pixels[image_row * width_ + column];
+      if (p > options_.occupied_threshold)
+        pixel = kOccupiedPixel;
+      else if (p < options_.free_threshold)
+        pixel = kFreePixel;
+    }
+  }
+  return pixels;
+}
+
+void OccupancyGrid::write_map_server(const std::string& pgm_or_base_path) const {
+  std::string base = pgm_or_base_path;
+  for (const char* extension : {".pgm", ".yaml"})
+    if (ends_with(base, extension)) base.resize(base.size() - std::string(extension).size());
+  const std::string pgm_path = base + ".pgm";
+  const std::string yaml_path = base + ".yaml";
+  if (log_odds_.empty()) fail(pgm_path, "the occupancy grid is empty: no scan was inserted");
+
+  // The image first: a YAML that exists always names a complete image.
+  write_pgm(pgm_path, width_, height_, render());
+  const Eigen::Vector2d lower_left = origin();
+  const std::string yaml =
+      "image: " + yaml_string(std::filesystem::path(pgm_path).filename().string()) + "\n" +
+      "resolution: " + yaml_number(options_.resolution) + "\n" + "origin: [" +
+      yaml_number(lower_left.x()) + ", " + yaml_number(lower_left.y()) + ", 0.0]\n" +
+      "negate: 0\n" + "occupied_thresh: " + yaml_number(options_.occupied_threshold) + "\n" +
+      "free_thresh: " + yaml_number(options_.free_threshold) + "\n" + "mode: trinary\n";
+  write_file_atomic(yaml_path, yaml);
+}
+
+void OccupancyGrid::write_png(const std::string& path) const {
+  if (log_odds_.empty()) fail(path, "the occupancy grid is empty: no scan was inserted");
+  scanmatch::write_png(path, width_, height_, render());
+}
+
+}  // namespace scanmatch

@@ -1,0 +1,52 @@
+#pragma once
+// 2D scan-to-scan mapping (METHODS.md section 2 step 6): each scan is registered onto the previous
+// one from a motion prior and the results are chained into global laser poses.
+
+#include <cstddef>
+#include <string>
+
+#include "scanmatch/registration/scan2d.hpp"
+
+namespace scanmatch {
+
+struct Mapper2DConfig {
+  Registration2DOptions registration;
+  /// Initial guess of each step: the previous step's motion (constant velocity) or none (the
+  /// identity). The paper chains with the previous result.
+  bool constant_velocity = true;
+  double min_range = 0.05;  ///< m: nearer returns are dropped
+  /// A result that moves farther than this from the initial guess is a failed match, not a
+  /// motion: the scan is bridged by the guess, so that one failure does not become the next
+  /// scan's constant-velocity guess.
+  double max_correction = 2.0;                      ///< m
+  double max_correction_angle = 60.0 * M_PI / 180;  ///< rad
+};
+
+struct Scan2DStats {
+  double ms = 0.0;  ///< registration time
+  int iterations = 0;
+  std::size_t points = 0, pairs = 0;
+  double error = 0.0;    ///< mean distance of the final correspondences, m
+  bool bridged = false;  ///< the scan could not be registered: the motion prior was used
+};
+
+class Mapper2D {
+ public:
+  /// Throws Error for an unknown method.
+  explicit Mapper2D(const Mapper2DConfig& config);
+  /// Registers the next scan; returns the laser's pose in the frame of the first scan. A scan too
+  /// small to register is bridged by the motion prior (last_stats().bridged), never fatal.
+  Pose2 add_scan(const Scan2D& scan);
+  const Scan2DStats& last_stats() const { return stats_; }
+  const Pose2& pose() const { return pose_; }
+  std::size_t scans() const { return scans_; }
+
+ private:
+  Mapper2DConfig config_;
+  Scan2D previous_;
+  Pose2 pose_ = Pose2::Identity(), motion_ = Pose2::Identity();
+  std::size_t scans_ = 0;
+  Scan2DStats stats_;
+};
+
+}  // namespace scanmatch

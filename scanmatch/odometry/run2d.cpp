@@ -1,0 +1,173 @@
+#include "scanmatch/odometry/run2d.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/core/progress.hpp"
+#include "scanmatch/io/file_util.hpp"
+#include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/sim/simulator.hpp"
+
+namespace scanmatch {
+namespace {
+
+namespace fs = std::filesystem;
+
+Pose2 planar(const Eigen::Vector3d& xytheta) {
+  return pose2(xytheta.x(), xytheta.y(), xytheta.z());
+}
+
+Pose to_pose3(const Pose2& T) {
+  return from_xyz_rpy(T.translation().x(), T.translation().y(), 0, 0, 0, pose2_angle(T));
+}
+
+nlohmann::ordered_json error_json(const RelativeError2D& e) {
+  return {{"step", e.step},
+          {"pairs", e.pairs},
+          {"mean_translation_mm", 1000 * e.mean_translation},
+          {"median_translation_mm", 1000 * e.median_translation},
+          {"max_translation_mm", 1000 * e.max_translation},
+          {"mean_rotation_deg", e.mean_rotation * 180 / M_PI},
+          {"median_rotation_deg", e.median_rotation * 180 / M_PI},
+          {"failure_rate", e.failure_rate}};
+}
+
+}  // namespace
+
+Scans2D load_scans_2d(const std::string& spec, std::size_t max_scans, std::uint64_t seed,
+                      bool motion_distortion) {
+  Scans2D out;
+  if (spec.rfind("sim:", 0) == 0) {
+    sim::SimOptions o;
+    o.preset = spec.substr(4);
+    o.seed = seed;
+    o.motion_distortion = motion_distortion;
+    if (max_scans > 0) o.frames = max_scans;
+    const sim::Simulator simulator(o);
+    if (!simulator.sensor().is_2d())
+      throw Error(spec + ": not a 2D preset (the 2D preset is room-2d)");
+    for (std::size_t i = 0; i < simulator.size(); ++i) out.scans.push_back(simulator.scan_2d(i));
+    out.has_reference = true;
+    out.description = fmt::format("{} (simulated, seed {})", spec, seed);
+    return out;
+  }
+  std::string path = spec;
+  if (fs::is_directory(spec)) {
+    path = (fs::path(spec) / "scans.log").string();
+    if (!fs::exists(path)) throw Error(spec + ": a folder without scans.log (not a 2D data set)");
+  } else if (!fs::exists(spec)) {
+    throw Error(spec + ": no such file or folder");
+  }
+  CarmenLog log = read_carmen_log(path);
+  if (log.scans.empty()) throw Error(path + ": the log holds no laser scans");
+  if (max_scans > 0 && log.scans.size() > max_scans) log.scans.resize(max_scans);
+  out.scans = std::move(log.scans);
+  for (const LaserScan2D& s : out.scans)
+    if (!s.pose.isZero()) out.has_reference = true;
+  out.description = path;
+  return out;
+}
+
+Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
+                       const Map2DRunOptions& options) {
+  std::error_code ec;
+  fs::create_directories(run_folder, ec);
+  if (ec) throw Error(run_folder + ": cannot create the run folder: " + ec.message());
+  const auto file = [&](const std::string& name) { return (fs::path(run_folder) / name).string(); };
+  Mapper2D mapper(options.mapper);
+  OccupancyGrid grid(options.grid), reference_grid(options.grid);
+  TrajectoryWriter poses(file("poses_tum.txt"), TrajectoryFormat::kTum);
+  std::FILE* timing = std::fopen(file("timing.csv").c_str(), "w");
+  if (!timing) throw Error(file("timing.csv") + ": cannot open for writing");
+  std::fprintf(timing, "scan,ms,iterations,points,pairs,error_m,bridged\n");
+  std::fflush(timing);
+
+  Map2DSummary summary;
+  summary.has_reference = input.has_reference;
+  std::vector<Pose2> estimate, reference;
+  Trajectory reference_trajectory;
+  ProgressReporter progress("map2d", input.scans.size(), "scans", options.quiet);
+  double total_ms = 0.0;
+  for (std::size_t i = 0; i < input.scans.size(); ++i) {
+    if (options.stop && options.stop->load()) {
+      summary.interrupted = true;
+      break;
+    }
+    const LaserScan2D& laser = input.scans[i];
+    const double miss_range =
+        options.miss_range > 0.0 ? std::min<double>(options.miss_range, laser.max_range) : 0.0;
+    Scan2D scan = scan_from_laser(laser, options.mapper.min_range, miss_range);
+    if (options.miss_range <= 0.0) scan.misses.clear();
+    const Pose2 pose = mapper.add_scan(scan);
+    const Scan2DStats& s = mapper.last_stats();
+    estimate.push_back(pose);
+    reference.push_back(planar(laser.pose));
+    poses.write(to_pose3(pose), laser.timestamp);
+    std::fprintf(timing, "%zu,%.4f,%d,%zu,%zu,%.6f,%d\n", i, s.ms, s.iterations, s.points, s.pairs,
+                 s.error, s.bridged ? 1 : 0);
+    std::fflush(timing);
+    grid.insert_scan(pose, scan.points, scan.misses);
+    if (options.reference_map && input.has_reference)
+      reference_grid.insert_scan(reference.front().inverse() * reference.back(), scan.points,
+                                 scan.misses);
+    reference_trajectory.poses.push_back(to_pose3(reference.front().inverse() * reference.back()));
+    reference_trajectory.timestamps.push_back(laser.timestamp);
+    summary.bridged += s.bridged;
+    summary.max_ms = std::max(summary.max_ms, s.ms);
+    total_ms += s.ms;
+    progress.update(i + 1);
+  }
+  progress.finish();
+  std::fclose(timing);
+  summary.scans = estimate.size();
+  if (summary.scans > 1) {
+    summary.mean_ms = total_ms / static_cast<double>(summary.scans - 1);
+    summary.scans_per_second = 1000.0 / std::max(summary.mean_ms, 1e-9);
+  }
+  if (input.has_reference && !reference_trajectory.poses.empty()) {
+    write_trajectory(file("poses_reference_tum.txt"), reference_trajectory, TrajectoryFormat::kTum);
+    if (summary.scans > 1) summary.one_step = relative_pose_error_2d(reference, estimate, 1);
+    if (summary.scans > 10) summary.ten_steps = relative_pose_error_2d(reference, estimate, 10);
+  }
+  if (summary.scans > 0) {
+    grid.write_map_server(file("map.pgm"));
+    grid.write_png(file("map.png"));
+    if (options.reference_map && input.has_reference) {
+      reference_grid.write_map_server(file("map_reference.pgm"));
+      reference_grid.write_png(file("map_reference.png"));
+    }
+  }
+  const Registration2DOptions& r = options.mapper.registration;
+  nlohmann::ordered_json j;
+  j["input"] = input.description;
+  j["method"] = r.method;
+  j["options"] = {
+      {"initial_guess", options.mapper.constant_velocity ? "constant-velocity" : "identity"},
+      {"max_iterations", r.max_iterations},
+      {"tolerance", r.tolerance},
+      {"max_correspondence_distance", r.max_correspondence_distance},
+      {"coarse_rotation", r.coarse_rotation},
+      {"coarse_translation", r.coarse_translation},
+      {"subsample_projection", r.subsample_projection},
+      {"sparse_step", r.sparse_step},
+      {"search_window", r.search_window},
+      {"search_angle_deg", r.search_angle * 180 / M_PI},
+      {"grid_resolution", options.grid.resolution},
+      {"miss_range", options.miss_range}};
+  j["scans"] = summary.scans;
+  j["bridged"] = summary.bridged;
+  j["interrupted"] = summary.interrupted;
+  j["mean_ms"] = summary.mean_ms;
+  j["max_ms"] = summary.max_ms;
+  j["scans_per_second"] = summary.scans_per_second;
+  if (summary.one_step.pairs > 0) j["relative_error_1"] = error_json(summary.one_step);
+  if (summary.ten_steps.pairs > 0) j["relative_error_10"] = error_json(summary.ten_steps);
+  write_file_atomic(file("summary.json"), j.dump(2) + "\n");
+  return summary;
+}
+
+}  // namespace scanmatch

@@ -1,0 +1,50 @@
+#pragma once
+// `scanmatch map2d` as a library call: 2D scans from a CARMEN log, a simulated data set or
+// `sim:PRESET`, chained scan to scan by Mapper2D, written as a run folder with an occupancy grid.
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "scanmatch/eval/metrics2d.hpp"
+#include "scanmatch/odometry/grid_map.hpp"
+#include "scanmatch/odometry/mapper2d.hpp"
+
+namespace scanmatch {
+
+struct Scans2D {
+  std::vector<LaserScan2D> scans;
+  bool has_reference = false;  ///< the scans' poses are a reference (log-corrected or simulated)
+  std::string description;
+};
+
+/// A CARMEN log (.log, .log.gz), a folder holding scans.log (a simulated 2D data set) or
+/// `sim:PRESET` with a 2D sensor. Throws Error naming the input and the problem.
+/// `motion_distortion` applies to `sim:` only (false: each scan measured from its start pose).
+Scans2D load_scans_2d(const std::string& spec, std::size_t max_scans = 0, std::uint64_t seed = 1,
+                      bool motion_distortion = true);
+
+struct Map2DRunOptions {
+  Mapper2DConfig mapper;
+  GridMapOptions grid;
+  /// No-return beams mark free space out to this range, m (0: none, the default: a dropout looks
+  /// like a no-return beam, and its free ray would cut through the wall it missed).
+  double miss_range = 0.0;
+  bool reference_map = false;  ///< also map_reference.{pgm,yaml,png} from the reference poses
+  bool quiet = false;
+  const std::atomic<bool>* stop = nullptr;  ///< set to end early (Ctrl-C); what is done is kept
+};
+
+struct Map2DSummary {
+  std::size_t scans = 0, bridged = 0;
+  double mean_ms = 0, max_ms = 0, scans_per_second = 0;
+  bool interrupted = false, has_reference = false;
+  RelativeError2D one_step, ten_steps;
+};
+
+/// Writes RUNDIR/poses_tum.txt and timing.csv (flushed per scan), poses_reference_tum.txt,
+/// summary.json and map.{pgm,yaml,png} (atomically).
+Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
+                       const Map2DRunOptions& options);
+
+}  // namespace scanmatch

@@ -1,0 +1,613 @@
+#include "scanmatch/registration/scan2d.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <nanoflann.hpp>
+#include <optional>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/features/angle_histogram.hpp"
+
+namespace scanmatch {
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+using Points2 = std::vector<Vec2>;
+
+constexpr std::size_t kMinPoints = 5;
+
+struct Points2Adaptor {
+  const Points2& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  double kdtree_get_pt(std::size_t i, std::size_t dim) const {
+    return points[i][static_cast<int>(dim)];
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using Tree2 =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Points2Adaptor>,
+                                        Points2Adaptor, 2, std::size_t>;
+
+class NearestNeighbours2D {
+ public:
+  explicit NearestNeighbours2D(const Points2& points)
+      : adaptor_{points}, tree_(2, adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
+    tree_.buildIndex();
+  }
+  /// Index of the nearest point and its squared distance.
+  std::pair<std::size_t, double> nearest(const Vec2& q) const {
+    std::size_t index = 0;
+    double squared = 0.0;
+    nanoflann::KNNResultSet<double, std::size_t> result(1);
+    result.init(&index, &squared);
+    tree_.findNeighbors(result, q.data(), nanoflann::SearchParams());
+    return {index, squared};
+  }
+
+ private:
+  Points2Adaptor adaptor_;
+  Tree2 tree_;
+};
+
+CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
+                              double max_distance, const NearestNeighbours2D* reference_tree);
+
+std::pair<std::size_t, double> brute_force_nearest(const Points2& points, const Vec2& q) {
+  std::size_t best = 0;
+  double best_squared = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    const double d = (points[j] - q).squaredNorm();
+    if (d < best_squared) {
+      best_squared = d;
+      best = j;
+    }
+  }
+  return {best, best_squared};
+}
+
+Points2 transformed(const Points2& points, const Pose2& T) {
+  Points2 out(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) out[i] = T * points[i];
+  return out;
+}
+
+Vec2 centroid(const Points2& points) {
+  Vec2 c = Vec2::Zero();
+  for (const Vec2& p : points) c += p;
+  return points.empty() ? c : Vec2(c / static_cast<double>(points.size()));
+}
+
+bool small_step(const Pose2& step, double tolerance) {
+  return step.translation().norm() < tolerance && std::abs(pose2_angle(step)) < tolerance;
+}
+
+/// Unit normals of a scan from its beam-order neighbours; zero where a point has no neighbour
+/// within `max_gap` on either side (an isolated return has no surface direction).
+Points2 scan_normals(const Points2& points, bool circular, double max_gap) {
+  const std::size_t n = points.size();
+  Points2 normals(n, Vec2::Zero());
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool has_prev = i > 0 || circular, has_next = i + 1 < n || circular;
+    Vec2 a = points[i], b = points[i];
+    if (has_prev && (points[(i + n - 1) % n] - points[i]).norm() < max_gap)
+      a = points[(i + n - 1) % n];
+    if (has_next && (points[(i + 1) % n] - points[i]).norm() < max_gap) b = points[(i + 1) % n];
+    const Vec2 d = b - a;
+    if (d.norm() > 1e-9) normals[i] = Vec2(-d.y(), d.x()).normalized();
+  }
+  return normals;
+}
+
+struct Pairs {
+  Points2 from, to;
+  double distance_sum = 0.0;
+  void clear() {
+    from.clear();
+    to.clear();
+    distance_sum = 0.0;
+  }
+};
+
+// One point-to-point ICP: nearest neighbours (brute force or k-d tree), optional normal
+// rejection, SVD step.
+Registration2DResult point_to_point_icp(const Scan2D& current, const Scan2D& reference,
+                                        const Registration2DOptions& o, const Pose2& initial,
+                                        bool use_tree, bool normal_rejection) {
+  std::optional<NearestNeighbours2D> tree;
+  if (use_tree) tree.emplace(reference.points);
+  Points2 reference_normals, current_normals;
+  if (normal_rejection) {
+    const double gap = 3 * o.max_correspondence_distance;
+    reference_normals = scan_normals(reference.points, reference.circular, gap);
+    current_normals = scan_normals(current.points, current.circular, gap);
+  }
+  const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
+  const double min_cos = std::cos(o.normal_angle);
+  Registration2DResult r;
+  r.transform = initial;
+  Pairs pairs;
+  for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
+    pairs.clear();
+    const Eigen::Matrix2d R = r.transform.linear();
+    for (std::size_t i = 0; i < current.points.size(); ++i) {
+      const Vec2 p = r.transform * current.points[i];
+      const auto [j, squared] =
+          use_tree ? tree->nearest(p) : brute_force_nearest(reference.points, p);
+      if (squared > max_squared) continue;
+      if (normal_rejection) {
+        const Vec2& nr = reference_normals[j];
+        const Vec2 nc = R * current_normals[i];
+        if (nr.isZero() || nc.isZero() || std::abs(nr.dot(nc)) < min_cos) continue;
+      }
+      pairs.from.push_back(current.points[i]);
+      pairs.to.push_back(reference.points[j]);
+      pairs.distance_sum += std::sqrt(squared);
+    }
+    r.pairs = pairs.from.size();
+    if (r.pairs < 3) break;
+    const Pose2 next = align_svd(pairs.from, pairs.to);
+    const Pose2 step = next * r.transform.inverse();
+    r.transform = next;
+    r.error = pairs.distance_sum / static_cast<double>(r.pairs);
+    if (small_step(step, o.tolerance)) {
+      r.converged = true;
+      break;
+    }
+  }
+  r.iterations = std::min(r.iterations, o.max_iterations);
+  return r;
+}
+
+// Censi's PL-ICP: each point against the line through its nearest reference point and the nearer
+// of that point's two beam-order neighbours; the worst pairs beyond keep_fraction are dropped.
+Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& reference,
+                                       const Registration2DOptions& o, const Pose2& initial) {
+  const NearestNeighbours2D tree(reference.points);
+  const std::size_t m = reference.points.size();
+  const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
+  struct LinePair {
+    Vec2 point, on_line, normal;
+    double distance;
+  };
+  std::vector<LinePair> pairs;
+  Points2 from, on_line, normals;
+  Registration2DResult r;
+  r.transform = initial;
+  for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
+    pairs.clear();
+    for (const Vec2& point : current.points) {
+      const Vec2 p = r.transform * point;
+      const auto [j, squared] = tree.nearest(p);
+      if (squared > max_squared) continue;
+      // The second point: the nearer beam-order neighbour of j, if it is close enough to be on
+      // the same surface.
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t k = j;
+      for (const long step : {-1L, 1L}) {
+        long candidate = static_cast<long>(j) + step;
+        if (reference.circular)
+          candidate = (candidate + static_cast<long>(m)) % static_cast<long>(m);
+        if (candidate < 0 || candidate >= static_cast<long>(m)) continue;
+        const double d = (reference.points[static_cast<std::size_t>(candidate)] - p).squaredNorm();
+        if (d < best) {
+          best = d;
+          k = static_cast<std::size_t>(candidate);
+        }
+      }
+      const Vec2 direction = reference.points[k] - reference.points[j];
+      if (k == j || direction.norm() < 1e-9 || direction.norm() > 2 * o.max_correspondence_distance)
+        continue;
+      const Vec2 normal = Vec2(-direction.y(), direction.x()).normalized();
+      pairs.push_back(
+          {point, reference.points[j], normal, std::abs(normal.dot(p - reference.points[j]))});
+    }
+    if (pairs.size() < 3) break;
+    const std::size_t keep = std::max<std::size_t>(
+        3,
+        static_cast<std::size_t>(std::ceil(o.keep_fraction * static_cast<double>(pairs.size()))));
+    if (keep < pairs.size()) {
+      std::nth_element(
+          pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
+          [](const LinePair& a, const LinePair& b) { return a.distance < b.distance; });
+      pairs.resize(keep);
+    }
+    from.clear();
+    on_line.clear();
+    normals.clear();
+    double sum = 0.0;
+    for (const LinePair& pair : pairs) {
+      from.push_back(pair.point);
+      on_line.push_back(pair.on_line);
+      normals.push_back(pair.normal);
+      sum += pair.distance;
+    }
+    r.pairs = pairs.size();
+    r.error = sum / static_cast<double>(r.pairs);
+    const Pose2 next = solve_point_to_line(from, on_line, normals);
+    const Pose2 step = next * r.transform.inverse();
+    r.transform = next;
+    if (small_step(step, o.tolerance)) {
+      r.converged = true;
+      break;
+    }
+  }
+  r.iterations = std::min(r.iterations, o.max_iterations);
+  return r;
+}
+
+// The nearest point to `p` on the segments from reference point j to its beam-order neighbours
+// (segments longer than `max_length` span a gap, not a surface, and are not used).
+Vec2 project_onto_neighbour_segments(const Scan2D& reference, std::size_t j, const Vec2& p,
+                                     double max_length) {
+  const std::size_t m = reference.points.size();
+  const Vec2& q = reference.points[j];
+  Vec2 best = q;
+  double best_squared = (p - q).squaredNorm();
+  for (const long step : {-1L, 1L}) {
+    long k = static_cast<long>(j) + step;
+    if (reference.circular) k = (k + static_cast<long>(m)) % static_cast<long>(m);
+    if (k < 0 || k >= static_cast<long>(m)) continue;
+    const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
+    const double length_squared = d.squaredNorm();
+    if (length_squared < 1e-18 || length_squared > max_length * max_length) continue;
+    const double s = std::clamp((p - q).dot(d) / length_squared, 0.0, 1.0);
+    const Vec2 candidate = q + s * d;
+    const double squared = (p - candidate).squaredNorm();
+    if (squared < best_squared) {
+      best_squared = squared;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+// Unit normal of the reference segment beside point j that `on_segment` lies on (zero when j has
+// no usable neighbour).
+Vec2 segment_normal(const Scan2D& reference, std::size_t j, const Vec2& on_segment,
+                    double max_length) {
+  const std::size_t m = reference.points.size();
+  const Vec2& q = reference.points[j];
+  Vec2 best = Vec2::Zero();
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (const long step : {-1L, 1L}) {
+    long k = static_cast<long>(j) + step;
+    if (reference.circular) k = (k + static_cast<long>(m)) % static_cast<long>(m);
+    if (k < 0 || k >= static_cast<long>(m)) continue;
+    const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
+    const double length = d.norm();
+    if (length < 1e-9 || length > max_length) continue;
+    const Vec2 n(-d.y() / length, d.x() / length);
+    const double distance =
+        std::abs(n.dot(on_segment - q)) + ((on_segment - q).dot(d) < 0 ? 1.0 : 0.0);
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = n;
+    }
+  }
+  return best;
+}
+
+Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
+                                const Registration2DOptions& o, const Pose2& initial, bool coarse) {
+  Registration2DResult r;
+  r.transform = initial;
+  if (coarse && (o.coarse_rotation || o.coarse_translation))
+    r.transform = coarse_alignment_2d(transformed(current.points, initial), reference.points,
+                                      o.histogram_bin, o.histogram_max_rotation, o.coarse_rotation,
+                                      o.coarse_translation, o.histogram_min_segment) *
+                  initial;
+  Pairs pairs;
+  Points2 line_points, normals;
+  const bool point_to_line = o.sparse_step == "point-to-line";
+  const NearestNeighbours2D tree(reference.points);
+  for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
+    const Points2 moved = transformed(current.points, r.transform);
+    const CorrespondencePath path = trace_path(moved, reference.points, reference.circular,
+                                               o.max_correspondence_distance, &tree);
+    pairs.clear();
+    if (point_to_line) {
+      line_points.clear();
+      normals.clear();
+    }
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+      if (!path.valid[i]) continue;
+      const std::size_t j = static_cast<std::size_t>(path.row[i]);
+      if (point_to_line) {
+        const Vec2 q =
+            project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
+        const Vec2 normal = segment_normal(reference, j, q, o.max_correspondence_distance);
+        if (normal.isZero()) continue;
+        pairs.from.push_back(current.points[i]);
+        pairs.to.push_back(q);
+        line_points.push_back(reference.points[j]);
+        normals.push_back(normal);
+        pairs.distance_sum += std::abs(normal.dot(moved[i] - reference.points[j]));
+        continue;
+      }
+      const Vec2 q = o.subsample_projection
+                         ? project_onto_neighbour_segments(reference, j, moved[i],
+                                                           o.max_correspondence_distance)
+                         : reference.points[j];
+      pairs.from.push_back(current.points[i]);
+      pairs.to.push_back(q);
+      pairs.distance_sum += (moved[i] - q).norm();
+    }
+    r.pairs = pairs.from.size();
+    if (r.pairs < 3) break;
+    const Pose2 next = point_to_line ? solve_point_to_line(pairs.from, line_points, normals)
+                                     : align_svd(pairs.from, pairs.to);
+    const Pose2 step = next * r.transform.inverse();
+    r.transform = next;
+    r.error = pairs.distance_sum / static_cast<double>(r.pairs);
+    if (small_step(step, o.tolerance)) {
+      r.converged = true;
+      break;
+    }
+  }
+  r.iterations = std::min(r.iterations, o.max_iterations);
+  return r;
+}
+
+void check_scan(const Scan2D& scan, const char* which) {
+  if (scan.points.size() < kMinPoints)
+    throw Error(std::string("2D registration: the ") + which + " scan has " +
+                std::to_string(scan.points.size()) + " valid points, at least " +
+                std::to_string(kMinPoints) + " are needed");
+  for (const Vec2& p : scan.points)
+    if (!p.allFinite())
+      throw Error(std::string("2D registration: the ") + which + " scan has a non-finite point");
+}
+
+}  // namespace
+
+Pose2 pose2(double x, double y, double theta) {
+  Pose2 T = Pose2::Identity();
+  T.linear() = Eigen::Rotation2Dd(theta).toRotationMatrix();
+  T.translation() = Vec2(x, y);
+  return T;
+}
+
+double pose2_angle(const Pose2& T) {
+  return std::atan2(T.linear()(1, 0), T.linear()(0, 0));
+}
+
+Scan2D scan_from_laser(const LaserScan2D& scan, double min_range, double miss_range) {
+  Scan2D out;
+  const double max_range = scan.max_range;
+  const double free_range = miss_range > 0.0 ? miss_range : max_range;
+  out.points.reserve(scan.ranges.size());
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double range = scan.ranges[i];
+    const double angle = scan.angle_min + static_cast<double>(i) * scan.angle_increment;
+    const Vec2 direction(std::cos(angle), std::sin(angle));
+    if (!std::isfinite(range)) continue;
+    if (range >= max_range) {
+      out.misses.push_back(free_range * direction);
+      continue;
+    }
+    if (range <= min_range) continue;
+    out.points.push_back(range * direction);
+  }
+  const double span = static_cast<double>(scan.ranges.size()) * std::abs(scan.angle_increment);
+  out.circular = span > 2 * M_PI - 1.5 * std::abs(scan.angle_increment);
+  return out;
+}
+
+const std::vector<std::string>& registration_2d_method_names() {
+  static const std::vector<std::string> names = {"sparse-icp", "icp", "icp-kdtree", "pl-icp",
+                                                 "normal-icp"};
+  return names;
+}
+
+Pose2 align_svd(const Points2& from, const Points2& to) {
+  if (from.size() != to.size() || from.size() < 2)
+    throw Error("align_svd: needs two or more pairs of points");
+  const Vec2 mu_p = centroid(from), mu_q = centroid(to);
+  Eigen::Matrix2d W = Eigen::Matrix2d::Zero();
+  for (std::size_t i = 0; i < from.size(); ++i) W += (to[i] - mu_q) * (from[i] - mu_p).transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix2d> svd(W, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix2d U = svd.matrixU();
+  const Eigen::Matrix2d V = svd.matrixV();
+  if ((U * V.transpose()).determinant() < 0) U.col(1) *= -1;  // a reflection is not a rotation
+  Pose2 T = Pose2::Identity();
+  T.linear() = U * V.transpose();
+  T.translation() = mu_q - T.linear() * mu_p;
+  return T;
+}
+
+Pose2 coarse_alignment_2d(const Points2& current, const Points2& reference, double bin_width,
+                          double max_rotation, bool rotation, bool translation,
+                          double min_segment) {
+  Pose2 correction = Pose2::Identity();
+  if (rotation) {
+    const double angle =
+        histogram_rotation(angle_histogram(current, bin_width, 0.5, min_segment),
+                           angle_histogram(reference, bin_width, 0.5, min_segment), max_rotation);
+    correction.linear() = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  }
+  if (translation)
+    correction.translation() = centroid(reference) - correction.linear() * centroid(current);
+  return correction;
+}
+
+CorrespondencePath correspondence_path(const Points2& current, const Points2& reference,
+                                       bool circular, double max_distance) {
+  return trace_path(current, reference, circular, max_distance, nullptr);
+}
+
+namespace {
+CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
+                              double max_distance, const NearestNeighbours2D* reference_tree) {
+  const long n = static_cast<long>(current.size()), m = static_cast<long>(reference.size());
+  CorrespondencePath path;
+  path.row.assign(static_cast<std::size_t>(n), 0);
+  path.valid.assign(static_cast<std::size_t>(n), false);
+  if (n == 0 || m == 0) return path;
+  const auto distance = [&](long i, long j) {
+    const Vec2 d = current[static_cast<std::size_t>(i)] - reference[static_cast<std::size_t>(j)];
+    return std::abs(d.x()) + std::abs(d.y());
+  };
+  const auto column_minimum = [&](long i) {
+    if (reference_tree)  // the Euclidean nearest: the Manhattan minimum or next to it
+      return static_cast<long>(reference_tree->nearest(current[static_cast<std::size_t>(i)]).first);
+    long best = 0;
+    for (long j = 1; j < m; ++j)
+      if (distance(i, j) < distance(i, best)) best = j;
+    return best;
+  };
+  // Rows outside the scan do not exist for an open scan; a circular scan wraps.
+  const auto neighbour = [&](long j, long step) -> long {
+    const long k = j + step;
+    if (circular) return (k + m) % m;
+    return k < 0 || k >= m ? -1 : k;
+  };
+  const auto row_step = [&](long from, long to) {
+    long d = to - from;
+    if (circular) {
+      if (d > m / 2) d -= m;
+      if (d < -m / 2) d += m;
+    }
+    return d;
+  };
+
+  std::vector<double> best_distance(static_cast<std::size_t>(n));
+  long j = column_minimum(0);
+  for (long i = 0; i < n; ++i) {
+    if (i > 0) {
+      // The 3x1 window slides from the previous row towards decreasing distance.
+      for (long moves = 0; moves < m; ++moves) {
+        long best = j;
+        for (const long step : {-1L, 1L}) {
+          const long k = neighbour(j, step);
+          if (k >= 0 && distance(i, k) < distance(i, best)) best = k;
+        }
+        if (best == j) break;
+        j = best;
+      }
+      if (distance(i, j) > max_distance) {  // lost: pick the path up again, then settle
+        j = column_minimum(i);
+        for (const long step : {-1L, 1L}) {
+          const long k = neighbour(j, step);
+          if (k >= 0 && distance(i, k) < distance(i, j)) j = k;
+        }
+      }
+    }
+    path.row[static_cast<std::size_t>(i)] = static_cast<int>(j);
+    best_distance[static_cast<std::size_t>(i)] = distance(i, j);
+  }
+  // Invalid pairs: abnormal steps (repeat = many-to-one, skip = one-to-many, backwards, jumps),
+  // shared reference points and distances above the threshold. What is left is one-to-one.
+  for (long i = 0; i < n; ++i) {
+    const auto at = [&](long k) {
+      return static_cast<long>(path.row[static_cast<std::size_t>(k)]);
+    };
+    const bool normal_before = i > 0 && row_step(at(i - 1), at(i)) == 1;
+    const bool normal_after = i + 1 < n && row_step(at(i), at(i + 1)) == 1;
+    const bool shared = (i > 0 && at(i - 1) == at(i)) || (i + 1 < n && at(i + 1) == at(i));
+    const bool normal = i > 0 ? normal_before : normal_after;
+    path.valid[static_cast<std::size_t>(i)] =
+        normal && !shared && best_distance[static_cast<std::size_t>(i)] <= max_distance;
+  }
+  return path;
+}
+}  // namespace
+
+Pose2 solve_point_to_line(const Points2& points, const Points2& line_points,
+                          const Points2& normals) {
+  if (points.size() < 3 || line_points.size() != points.size() || normals.size() != points.size())
+    throw Error("point-to-line step: needs three or more pairs with a normal each");
+  // Unknowns x = (tx, ty, c, s): residual n . (M_i x - q_i), M_i = [1 0 px -py; 0 1 py px].
+  Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d g = Eigen::Vector4d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec2& p = points[i];
+    const Vec2& nrm = normals[i];
+    Eigen::Matrix<double, 2, 4> M;
+    M << 1, 0, p.x(), -p.y(), 0, 1, p.y(), p.x();
+    const Eigen::Matrix<double, 1, 4> a = nrm.transpose() * M;
+    H += a.transpose() * a;
+    g += a.transpose() * nrm.dot(line_points[i]);
+  }
+  // Eliminate t: for fixed v = (c, s), t = A^-1 (g_t - B v); the cost in v is v'Sv - 2h'v + k.
+  const Eigen::Matrix2d A = H.topLeftCorner<2, 2>(), B = H.topRightCorner<2, 2>(),
+                        D = H.bottomRightCorner<2, 2>();
+  const Eigen::Vector2d gt = g.head<2>(), gv = g.tail<2>();
+  if (std::abs(A.determinant()) < 1e-12)
+    throw Error("point-to-line step: translation is unconstrained");
+  const Eigen::Matrix2d Ainv = A.inverse();
+  const Eigen::Matrix2d S = D - B.transpose() * Ainv * B;
+  const Eigen::Vector2d h = gv - B.transpose() * Ainv * gt;
+  // Minimise v'Sv - 2h'v subject to |v| = 1: (S + l I) v = h with |v| = 1, i.e.
+  // |adj(S + l I) h|^2 = det(S + l I)^2, a quartic in l.
+  const double a = S(0, 0), b = S(0, 1), d = S(1, 1);
+  // adj(S + l I) h = (p0 + l h0, p1 + l h1) with p = adj(S) h.
+  const double p0 = d * h.x() - b * h.y(), p1 = a * h.y() - b * h.x();
+  // det(S + l I) = l^2 + (a + d) l + (a d - b^2).
+  const double c1 = a + d, c0 = a * d - b * b;
+  // det^2 - |adj h|^2 = 0, coefficients from l^4 down to l^0.
+  Eigen::Matrix<double, 5, 1> poly;
+  poly << 1.0, 2 * c1, c1 * c1 + 2 * c0 - h.squaredNorm(),
+      2 * c1 * c0 - 2 * (p0 * h.x() + p1 * h.y()), c0 * c0 - p0 * p0 - p1 * p1;
+  Eigen::Matrix4d companion = Eigen::Matrix4d::Zero();
+  for (int k = 0; k < 4; ++k) companion(0, k) = -poly(k + 1) / poly(0);
+  companion.bottomLeftCorner<3, 3>() = Eigen::Matrix3d::Identity();
+  const Eigen::EigenSolver<Eigen::Matrix4d> roots(companion, false);
+  Vec2 best_v(1, 0);
+  double best_cost = std::numeric_limits<double>::infinity();
+  const auto consider = [&](Vec2 v) {
+    if (!v.allFinite() || v.norm() < 1e-12) return;
+    v.normalize();
+    const double cost = v.dot(S * v) - 2 * h.dot(v);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best_v = v;
+    }
+  };
+  for (int k = 0; k < 4; ++k) {
+    const std::complex<double> lambda = roots.eigenvalues()(k);
+    if (std::abs(lambda.imag()) > 1e-6 * std::max(1.0, std::abs(lambda.real()))) continue;
+    const Eigen::Matrix2d K = S + lambda.real() * Eigen::Matrix2d::Identity();
+    if (std::abs(K.determinant()) < 1e-15) continue;
+    consider(K.inverse() * h);
+  }
+  // Should rounding lose every real root, the unconstrained direction still gives a rotation.
+  consider(h);
+  Pose2 T = Pose2::Identity();
+  T.linear() << best_v.x(), -best_v.y(), best_v.y(), best_v.x();
+  T.translation() = Ainv * (gt - B * best_v);
+  return T;
+}
+
+Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
+                                    const Registration2DOptions& o, const Pose2& initial) {
+  const auto& names = registration_2d_method_names();
+  if (std::find(names.begin(), names.end(), o.method) == names.end())
+    throw Error("unknown 2D registration method '" + o.method +
+                "' (sparse-icp, icp, icp-kdtree, pl-icp, normal-icp)");
+  if (!(o.max_correspondence_distance > 0.0))
+    throw Error("2D registration: the correspondence distance must be positive");
+  if (o.max_iterations < 1) throw Error("2D registration: at least one iteration is needed");
+  if (o.sparse_step != "svd" && o.sparse_step != "point-to-line")
+    throw Error("2D registration: unknown sparse-icp step '" + o.sparse_step +
+                "' (svd, point-to-line)");
+  check_scan(current, "current");
+  check_scan(reference, "reference");
+  Pose2 start = initial;
+  const bool searched = o.search_window > 0.0;
+  if (searched)
+    start = correlative_search(current, reference, initial, o.search_window, o.search_angle,
+                               o.search_resolution);
+  if (o.method == "sparse-icp") return sparse_icp(current, reference, o, start, !searched);
+  if (o.method == "pl-icp") return point_to_line_icp(current, reference, o, start);
+  return point_to_point_icp(current, reference, o, start, o.method != "icp",
+                            o.method == "normal-icp");
+}
+
+}  // namespace scanmatch

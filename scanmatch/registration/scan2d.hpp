@@ -1,0 +1,137 @@
+#pragma once
+// 2D laser scan matching (METHODS.md section 2): the paper's sparse-correspondence method and the
+// baselines of its Table 1. Scans are points in the laser frame, in beam order; poses are
+// Eigen::Isometry2d (x, y, theta).
+//
+//   sparse-icp   angle-histogram rotation, centroid translation, the Manhattan-distance
+//                correspondence path with invalid pairs dropped, SVD ICP on what is left
+//   icp          point-to-point, brute-force nearest neighbours, SVD step
+//   icp-kdtree   the same with a k-d tree
+//   pl-icp       Censi's point-to-line ICP with its exact closed-form step (Lagrange multiplier)
+//   normal-icp   point-to-point with pairs rejected when their normals disagree
+//
+// The 2D methods do not use the 3D Gauss-Newton solver: the paper's method and Censi's are defined
+// by their closed-form steps (SVD, and the constrained quadratic), which are exact in one solve.
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "scanmatch/io/carmen.hpp"
+
+namespace scanmatch {
+
+using Pose2 = Eigen::Isometry2d;
+Pose2 pose2(double x, double y, double theta);
+double pose2_angle(const Pose2& T);  ///< theta in (-pi, pi]
+
+struct Scan2D {
+  std::vector<Eigen::Vector2d> points;  ///< valid returns, in beam order, laser frame, m
+  /// End points of no-return beams at the maximum range (free space for grid maps), laser frame.
+  std::vector<Eigen::Vector2d> misses;
+  bool circular = false;  ///< a 360-degree scan: the last beam neighbours the first
+};
+
+/// Valid beams (finite, range in (min_range, max_range)) as points, in beam order; `circular`
+/// when the beams cover the full circle. Beams at or beyond the maximum range become `misses`
+/// at `miss_range` (0: the scan's max range).
+Scan2D scan_from_laser(const LaserScan2D& scan, double min_range = 0.05, double miss_range = 0.0);
+
+struct Registration2DOptions {
+  std::string method = "sparse-icp";  ///< sparse-icp, icp, icp-kdtree, pl-icp, normal-icp
+  int max_iterations = 50;
+  double tolerance = 1e-4;  ///< m and rad: stop when a step is smaller than this
+  /// m: the paper's threshold D (Manhattan distance) for sparse-icp; the Euclidean rejection
+  /// distance of the baselines.
+  double max_correspondence_distance = 0.3;
+  /// sparse-icp coarse stage: the angle histogram's bin width, rad.
+  double histogram_bin = 1.0 * M_PI / 180;
+  /// sparse-icp coarse stage: histogram segments are extended to at least this length, m (0: the
+  /// paper's consecutive points, whose directions are mostly noise at 1 % range noise).
+  double histogram_min_segment = 0.15;
+  /// sparse-icp coarse stage: the histogram rotation is searched within +- this of the initial
+  /// guess, rad (rectilinear rooms give peaks every 90 degrees).
+  double histogram_max_rotation = 30.0 * M_PI / 180;
+  bool coarse_rotation = true;  ///< sparse-icp: angle-histogram rotation
+  /// sparse-icp: centroid translation. Off by default: two scans see different parts of a room,
+  /// so their centroids differ by more than the motion (on simulated pairs it turned 0 failures
+  /// into 7 in 300). The paper's setting is true.
+  bool coarse_translation = false;
+  /// sparse-icp: each kept pair's reference point is moved to the nearest point of the reference
+  /// segments beside it (to the previous and next beam). Two scans never sample a wall at the same
+  /// places; matching samples to samples leaves a bias of up to half the beam spacing, which this
+  /// removes (the fixed point becomes the point-to-line optimum). false: the paper's plain pairs.
+  bool subsample_projection = true;
+  /// sparse-icp's step on the kept pairs: "svd" (the paper: point-to-point, closed form) or
+  /// "point-to-line" (Censi's closed form against the reference segment of each kept pair).
+  std::string sparse_step = "svd";
+  double normal_angle = 30.0 * M_PI / 180;  ///< rad, normal-icp's rejection threshold
+  /// pl-icp: the worst pairs beyond this fraction are dropped each iteration (Censi's csm keeps
+  /// 95 %).
+  double keep_fraction = 0.95;
+  /// Correlative coarse search before any method (two-level branch and bound over the window
+  /// below), for steps the local methods cannot bridge (long corridors, fast turns). It replaces
+  /// sparse-icp's histogram and centroid stage. 0: off.
+  double search_window = 0.0;               ///< m, +- in x and y around the initial guess
+  double search_angle = 25.0 * M_PI / 180;  ///< rad, +- around the initial guess
+  double search_resolution = 0.05;          ///< m, cells of the search's likelihood grid
+};
+
+struct Registration2DResult {
+  Pose2 transform = Pose2::Identity();  ///< maps current-scan points into the reference frame
+  int iterations = 0;
+  double error = 0.0;     ///< mean distance of the final correspondences, m
+  std::size_t pairs = 0;  ///< correspondences used in the last step
+  bool converged = false;
+};
+
+/// Registers `current` onto `reference` from `initial`. Throws Error for an unknown method or
+/// scans too small to register (fewer than 5 points).
+Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
+                                    const Registration2DOptions& options,
+                                    const Pose2& initial = Pose2::Identity());
+
+const std::vector<std::string>& registration_2d_method_names();
+
+// The steps of sparse-icp, exposed for tests and reuse.
+
+/// Rigid transform minimising sum |R p_i + t - q_i|^2 (SVD with reflection guard). Needs two
+/// pairs or more.
+Pose2 align_svd(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to);
+
+/// sparse-icp's coarse stage: the histogram rotation (within `max_rotation`) about the origin,
+/// then the translation between the centroids. Returns the correction to apply to `current`.
+Pose2 coarse_alignment_2d(const std::vector<Eigen::Vector2d>& current,
+                          const std::vector<Eigen::Vector2d>& reference, double bin_width,
+                          double max_rotation, bool rotation = true, bool translation = true,
+                          double min_segment = 0.0);
+
+struct CorrespondencePath {
+  std::vector<int> row;     ///< reference index matched to each current point (the path)
+  std::vector<bool> valid;  ///< kept after the invalid-pair rules
+};
+/// The Manhattan-distance correspondence path of METHODS.md section 2 steps 3-4: start at the
+/// minimum of the first column, then for each next column move a 3x1 window from the previous
+/// row towards decreasing distance until its centre is the window's minimum. A pair is kept only
+/// where the step from the previous pair is the normal one (next reference index), its reference
+/// point is not shared with a neighbouring column (many-to-one), and its Manhattan distance is at
+/// most `max_distance`. Where the window loses the surface (distance above `max_distance`), the
+/// column is searched in full once to pick the path up again. O(n + m) for overlapping scans.
+CorrespondencePath correspondence_path(const std::vector<Eigen::Vector2d>& current,
+                                       const std::vector<Eigen::Vector2d>& reference, bool circular,
+                                       double max_distance);
+
+/// Closed-form point-to-line step (Censi 2008): the transform minimising
+/// sum (n_i . (R p_i + t - q_i))^2 exactly, through the Lagrange multiplier of the constraint
+/// cos^2 + sin^2 = 1. Needs three pairs with non-parallel normals or more.
+Pose2 solve_point_to_line(const std::vector<Eigen::Vector2d>& points,
+                          const std::vector<Eigen::Vector2d>& line_points,
+                          const std::vector<Eigen::Vector2d>& normals);
+
+/// Correlative search: the pose within the window around `initial` whose transformed points best
+/// hit a smoothed likelihood grid of the reference, found exactly at the grid's resolution by a
+/// two-level branch and bound (a max-filtered grid bounds each block of translations).
+Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
+                         double window, double angle_window, double resolution = 0.05);
+
+}  // namespace scanmatch

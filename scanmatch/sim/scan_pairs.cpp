@@ -1,0 +1,94 @@
+#include "scanmatch/sim/scan_pairs.hpp"
+
+#include <unistd.h>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/sim/random.hpp"
+#include "scanmatch/sim/simulator.hpp"
+
+namespace scanmatch::sim {
+namespace {
+
+Eigen::Isometry2d planar(const Pose& p) {
+  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
+  T.linear() =
+      Eigen::Rotation2Dd(std::atan2(p.linear()(1, 0), p.linear()(0, 0))).toRotationMatrix();
+  T.translation() = p.translation().head<2>();
+  return T;
+}
+
+double median_range(const LaserScan2D& scan) {
+  std::vector<float> valid;
+  for (float r : scan.ranges)
+    if (r > 0.0f && r < scan.max_range) valid.push_back(r);
+  if (valid.empty()) return 0.0;
+  std::nth_element(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(valid.size() / 2),
+                   valid.end());
+  return valid[valid.size() / 2];
+}
+
+}  // namespace
+
+std::vector<PlanarScanPair> planar_scan_pairs(const PlanarPairOptions& options) {
+  if (options.count == 0) return {};
+  // The simulator renders a replayed trajectory: reference and current poses alternate, each
+  // measured from its frame's start pose (no distortion). The replay is anchored at the scene's
+  // loop start, so the first pose is that start and every later one is absolute.
+  const World world = make_rooms_2d(options.seed);
+  const Eigen::Vector2d start = world.loop.front();
+  Rng rng(options.seed * 7919 + 17);
+  Trajectory trajectory;
+  trajectory.poses.push_back(from_xyz_rpy(start.x(), start.y(), 0, 0, 0, 0));
+  // Two candidates per wanted pair: some land in furniture and are dropped after rendering.
+  for (std::size_t k = 0; k < 2 * options.count; ++k) {
+    const int room = static_cast<int>(rng.uniform(0, 3)) % 3;
+    Eigen::Vector2d a;
+    do {
+      a = Eigen::Vector2d(5.0 * room + rng.uniform(0.7, 4.3), rng.uniform(0.7, 3.3));
+    } while (world.scene.distance_to_surface(Eigen::Vector3d(a.x(), a.y(), 0.2)) < 0.4);
+    const double yaw = rng.uniform(-M_PI, M_PI);
+    const double r = options.max_translation * std::sqrt(rng.uniform(0, 1));
+    const double direction = rng.uniform(-M_PI, M_PI);
+    const Eigen::Vector2d b = a + r * Eigen::Vector2d(std::cos(direction), std::sin(direction));
+    const double yaw_b = yaw + rng.uniform(-options.max_rotation, options.max_rotation);
+    trajectory.poses.push_back(from_xyz_rpy(a.x(), a.y(), 0, 0, 0, yaw));
+    trajectory.poses.push_back(from_xyz_rpy(b.x(), b.y(), 0, 0, 0, yaw_b));
+  }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("scanmatch_pairs_" + std::to_string(::getpid()) +
+                                                 "_" + std::to_string(options.seed) + ".txt"))
+          .string();
+  write_trajectory(path, trajectory, TrajectoryFormat::kKitti);
+  SimOptions o;
+  o.preset = "room-2d";
+  o.seed = options.seed;
+  o.motion_distortion = false;
+  o.noise = options.noise;
+  o.trajectory_file = path;
+  o.frames = trajectory.size();
+  std::vector<PlanarScanPair> pairs;
+  try {
+    const Simulator simulator(o);
+    for (std::size_t i = 1; i + 1 < simulator.size() && pairs.size() < options.count; i += 2) {
+      PlanarScanPair p{simulator.scan_2d(i), simulator.scan_2d(i + 1),
+                       planar(simulator.pose(i)).inverse() * planar(simulator.pose(i + 1))};
+      // Inside a piece of furniture every return is a few centimetres away.
+      if (median_range(p.reference) < 0.8 || median_range(p.current) < 0.8) continue;
+      pairs.push_back(std::move(p));
+    }
+  } catch (...) {
+    std::filesystem::remove(path);
+    throw;
+  }
+  std::filesystem::remove(path);
+  if (pairs.size() < options.count)
+    throw Error("planar scan pairs: only " + std::to_string(pairs.size()) + " of " +
+                std::to_string(options.count) + " usable pairs");
+  return pairs;
+}
+
+}  // namespace scanmatch::sim
