@@ -139,8 +139,8 @@ std::string log_table(const std::string& path, const Bench2DOptions& o) {
       variants.push_back({m, cv ? "constant velocity" : "identity", cv, 0.0});
   if (o.search_window > 0.0)
     for (const std::string& m : o.methods)
-      variants.push_back({m, fmt::format("constant velocity + search {:.1f} m", o.search_window),
-                          true, o.search_window});
+      variants.push_back(
+          {m, fmt::format("identity + search {:.1f} m", o.search_window), false, o.search_window});
   ProgressReporter progress("bench2d " + std::filesystem::path(path).filename().string(),
                             variants.size() * scans.size(), "scans", o.quiet);
   std::size_t done = 0;

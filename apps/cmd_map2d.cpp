@@ -23,7 +23,7 @@ struct Map2DCommand {
   std::size_t scans = 0;
   std::uint64_t seed = 1;
   bool no_motion_distortion = false;
-  double search_angle_deg = 25.0;
+  double search_angle_deg = 25.0, keyframe_angle_deg = 0.0;
   Map2DRunOptions run;
 };
 
@@ -56,6 +56,15 @@ void add_map2d_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--search-angle", c->search_angle_deg, "Correlative search, +- deg")
       ->capture_default_str();
+  cmd->add_option("--keyframe-distance", c->run.mapper.keyframe_distance,
+                  "Match against the last keyframe, replaced after this many m (0: scan to scan)")
+      ->capture_default_str();
+  cmd->add_option("--keyframe-angle", c->keyframe_angle_deg,
+                  "... or after this many deg of turn (0: not by angle)")
+      ->capture_default_str();
+  cmd->add_option("--sparse-step", r.sparse_step,
+                  "sparse-icp's step on the kept pairs: svd (the paper) or point-to-line")
+      ->capture_default_str();
   cmd->add_flag("--centroid-translation", r.coarse_translation,
                 "sparse-icp: the paper's centroid translation in the coarse stage");
   cmd->add_option("--resolution", c->run.grid.resolution, "Grid cell size, m")
@@ -71,6 +80,7 @@ void add_map2d_command(CLI::App& app) {
       throw Error("map2d: --initial must be constant-velocity or identity");
     c->run.mapper.constant_velocity = c->initial == "constant-velocity";
     c->run.mapper.registration.search_angle = c->search_angle_deg * M_PI / 180;
+    c->run.mapper.keyframe_angle = c->keyframe_angle_deg * M_PI / 180;
     const Scans2D input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
     interrupted.store(false);
     c->run.stop = &interrupted;
@@ -94,6 +104,7 @@ void add_map2d_command(CLI::App& app) {
               "{:.2f} deg, failures {:.1f} %\n",
               e->step, 1000 * e->mean_translation, e->mean_rotation * 180 / M_PI,
               1000 * e->median_translation, e->median_rotation * 180 / M_PI, 100 * e->failure_rate);
+      if (!s.map_error.empty()) fmt::print("no map written: {}\n", s.map_error);
       fmt::print("run folder: {}\n", c->out);
     }
     if (s.interrupted) throw CLI::RuntimeError(130);

@@ -11,12 +11,15 @@
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/registration/methods.hpp"
+#include "scanmatch/registration/scan2d.hpp"
 
 namespace scanmatch::cli {
 namespace {
 
 struct RegisterCommand {
   std::string source, target, init, kernel = "none";
+  bool planar = false;
+  Registration2DOptions planar_options;
   double voxel = 0.1;
   bool json = false;
   RegistrationOptions options;
@@ -54,7 +57,66 @@ Pose parse_initial_guess(const std::string& text) {
       std::to_string(v.size()));
 }
 
+// "LOG" (its first scan) or "LOG:INDEX" (a CARMEN log; .gz allowed).
+LaserScan2D read_scan_2d(const std::string& spec) {
+  std::string path = spec;
+  std::size_t index = 0;
+  const auto colon = spec.rfind(':');
+  if (colon != std::string::npos && colon + 1 < spec.size() &&
+      spec.find_first_not_of("0123456789", colon + 1) == std::string::npos) {
+    path = spec.substr(0, colon);
+    index = std::stoul(spec.substr(colon + 1));
+  }
+  const CarmenLog log = read_carmen_log(path);
+  if (index >= log.scans.size())
+    throw Error(path + ": scan " + std::to_string(index) + " requested, the log has " +
+                std::to_string(log.scans.size()));
+  return log.scans[index];
+}
+
+void run_2d(RegisterCommand& c) {
+  Pose2 initial = Pose2::Identity();
+  if (!c.init.empty()) {
+    const Pose p = parse_initial_guess(c.init);
+    initial = pose2(p.translation().x(), p.translation().y(),
+                    std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
+  }
+  const Scan2D source = scan_from_laser(read_scan_2d(c.source));
+  const Scan2D target = scan_from_laser(read_scan_2d(c.target));
+  const auto start = std::chrono::steady_clock::now();
+  const Registration2DResult r = register_scans(source, target, c.planar_options, initial);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double x = r.transform.translation().x(), y = r.transform.translation().y();
+  const double theta = pose2_angle(r.transform);
+  if (c.json) {
+    nlohmann::ordered_json j;
+    j["method"] = c.planar_options.method;
+    j["x"] = x;
+    j["y"] = y;
+    j["theta_deg"] = theta * 180 / M_PI;
+    j["iterations"] = r.iterations;
+    j["converged"] = r.converged;
+    j["pairs"] = r.pairs;
+    j["error_m"] = r.error;
+    j["time_ms"] = ms;
+    fmt::print("{}\n", j.dump(2));
+    return;
+  }
+  fmt::print("x {:.4f} m, y {:.4f} m, theta {:.3f} deg\n", x, y, theta * 180 / M_PI);
+  fmt::print("method {}: {} iterations, {}, {} pairs, mean pair distance {:.4f} m, {:.2f} ms\n",
+             c.planar_options.method, r.iterations, r.converged ? "converged" : "not converged",
+             r.pairs, r.error, ms);
+}
+
 void run(RegisterCommand& c) {
+  if (c.planar) {
+    if (c.options.method != RegistrationOptions{}.method)
+      c.planar_options.method = c.options.method;
+    if (c.options.max_correspondence_distance != RegistrationOptions{}.max_correspondence_distance)
+      c.planar_options.max_correspondence_distance = c.options.max_correspondence_distance;
+    return run_2d(c);
+  }
   const Pose initial = c.init.empty() ? Pose::Identity() : parse_initial_guess(c.init);
   PointCloud source = read_cloud(c.source), target = read_cloud(c.target);
   if (source.empty()) throw Error(c.source + ": the cloud is empty");
@@ -136,6 +198,11 @@ void add_register_command(CLI::App& app) {
   cmd->add_flag("--lm", c->options.solver.levenberg_marquardt,
                 "Levenberg-Marquardt instead of Gauss-Newton");
   cmd->add_flag("--json", c->json, "Print JSON");
+  cmd->add_flag("--2d", c->planar,
+                "2D laser scans: SOURCE and TARGET are CARMEN logs, LOG or LOG:INDEX; methods "
+                "sparse-icp (default), icp, icp-kdtree, pl-icp, normal-icp");
+  cmd->add_option("--search-window", c->planar_options.search_window,
+                  "2D: correlative coarse search over +- this many m first (0: off)");
   cmd->callback([c] { run(*c); });
 }
 

@@ -325,6 +325,30 @@ TEST(Map2D, CliWritesARunFolderAndRejectsBadInput) {
   EXPECT_NE(missing.output.find("none.log"), std::string::npos) << missing.output;
 }
 
+TEST(Map2D, RegisterAcceptsTwoDimensionalScans) {
+  // Two scans of a simulated data set; `register --2d` must agree with the simulator's truth.
+  scanmatch::testing::TempDir dir;
+  const auto sim = scanmatch::testing::run_cli(
+      "simulate room-2d --frames 12 --no-motion-distortion --quiet --out " + dir.file("data"));
+  ASSERT_EQ(sim.status, 0) << sim.output;
+  const std::string log = dir.file("data/scans.log");
+  const auto r = scanmatch::testing::run_cli("register --2d " + log + ":11 " + log +
+                                             ":10 --method pl-icp --json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  const CarmenLog parsed = read_carmen_log(log);
+  const Pose2 truth =
+      pose2(parsed.scans[10].pose.x(), parsed.scans[10].pose.y(), parsed.scans[10].pose.z())
+          .inverse() *
+      pose2(parsed.scans[11].pose.x(), parsed.scans[11].pose.y(), parsed.scans[11].pose.z());
+  EXPECT_NEAR(j["x"].get<double>(), truth.translation().x(), 0.02);
+  EXPECT_NEAR(j["y"].get<double>(), truth.translation().y(), 0.02);
+  EXPECT_NEAR(j["theta_deg"].get<double>(), degrees(pose2_angle(truth)), 0.5);
+  const auto bad = scanmatch::testing::run_cli("register --2d " + log + ":11 " + log + ":500");
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("scan 500"), std::string::npos) << bad.output;
+}
+
 TEST(Map2D, RealCarmenLogBeatsTheCsmBaseline) {
   const std::string log = scanmatch::testing::shared_data("data/2d/carmen/intel-corrected.log.gz");
   if (log.empty()) GTEST_SKIP() << "../shared/data/2d/carmen is absent";

@@ -38,15 +38,18 @@ double histogram_rotation(const std::vector<double>& current, const std::vector<
                           double max_rotation) {
   const std::size_t n = current.size();
   if (n == 0 || reference.size() != n) throw Error("angle histograms differ in size");
-  std::vector<double> w(n, 0.0);
-  for (std::size_t shift = 0; shift < n; ++shift)
-    for (std::size_t i = 0; i < n; ++i) w[shift] += current[i] * reference[(i + shift) % n];
-  // Shift s turns current by s bins; shifts beyond max_rotation either way are not candidates.
+  // Shift s turns current by s bins; shifts beyond max_rotation either way are not candidates
+  // and are not computed (their neighbours are, for the parabola).
   const double width = 2 * M_PI / static_cast<double>(n);
   const auto allowed = [&](std::size_t s) {
     const double angle = static_cast<double>(s) * width;
     return std::min(angle, 2 * M_PI - angle) <= max_rotation + 1e-12;
   };
+  std::vector<double> w(n, 0.0);
+  for (std::size_t shift = 0; shift < n; ++shift) {
+    if (!allowed(shift) && !allowed((shift + 1) % n) && !allowed((shift + n - 1) % n)) continue;
+    for (std::size_t i = 0; i < n; ++i) w[shift] += current[i] * reference[(i + shift) % n];
+  }
   std::size_t best = 0;
   for (std::size_t s = 1; s < n; ++s)
     if (allowed(s) && w[s] > w[best]) best = s;

@@ -287,6 +287,35 @@ std::vector<Eigen::Vector2d> OccupancyGrid::occupied_cell_centres() const {
   return centres;
 }
 
+void OccupancyGrid::crop_to_observed(int margin) {
+  int min_x = width_, min_y = height_, max_x = -1, max_y = -1;
+  for (int row = 0; row < height_; ++row)
+    for (int column = 0; column < width_; ++column)
+      if (!std::isnan(log_odds_[static_cast<std::size_t>(row) * static_cast<std::size_t>(width_) +
+                                static_cast<std::size_t>(column)])) {
+        min_x = std::min(min_x, column);
+        max_x = std::max(max_x, column);
+        min_y = std::min(min_y, row);
+        max_y = std::max(max_y, row);
+      }
+  if (max_x < 0) return;
+  margin = std::max(0, margin);
+  min_x = std::max(0, min_x - margin);
+  min_y = std::max(0, min_y - margin);
+  max_x = std::min(width_ - 1, max_x + margin);
+  max_y = std::min(height_ - 1, max_y + margin);
+  const int new_width = max_x - min_x + 1, new_height = max_y - min_y + 1;
+  std::vector<float> cropped(static_cast<std::size_t>(new_width) *
+                             static_cast<std::size_t>(new_height));
+  for (int row = 0; row < new_height; ++row)
+    std::copy_n(log_odds_.begin() + static_cast<std::ptrdiff_t>(row + min_y) * width_ + min_x,
+                new_width, cropped.begin() + static_cast<std::ptrdiff_t>(row) * new_width);
+  log_odds_ = std::move(cropped);
+  origin_cell_ += Eigen::Vector2i(min_x, min_y);
+  width_ = new_width;
+  height_ = new_height;
+}
+
 std::vector<std::uint8_t> OccupancyGrid::render() const {
   std::vector<std::uint8_t> pixels(log_odds_.size(), kUnknownPixel);
   for (int row = 0; row < height_; ++row) {

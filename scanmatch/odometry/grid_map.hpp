@@ -92,6 +92,11 @@ class OccupancyGrid {
   /// World coordinates of the centre of cell (column, row); row 0 is the lowest y.
   Eigen::Vector2d cell_centre(int column, int row) const;
 
+  /// Shrinks the storage to the observed cells plus `margin` cells on each side, keeping every
+  /// cell at its world position, so that exported images hold the mapped area only (growth
+  /// leaves wide unobserved margins). Does nothing to an empty grid.
+  void crop_to_observed(int margin = 2);
+
   /// Centres of the occupied cells, row by row from the lowest y, each row by increasing x.
   std::vector<Eigen::Vector2d> occupied_cell_centres() const;
 

@@ -1,6 +1,6 @@
 #pragma once
 // 2D scan-to-scan mapping (METHODS.md section 2 step 6): each scan is registered onto the previous
-// one from a motion prior and the results are chained into global laser poses.
+// one (or the last keyframe) from a motion prior and the results are chained into global poses.
 
 #include <cstddef>
 #include <string>
@@ -20,6 +20,11 @@ struct Mapper2DConfig {
   /// scan's constant-velocity guess.
   double max_correction = 2.0;                      ///< m
   double max_correction_angle = 60.0 * M_PI / 180;  ///< rad
+  /// Scans are matched against the last keyframe, which is replaced once the sensor has moved
+  /// this far from it: errors then add up per keyframe, not per scan. 0 and 0: every scan is a
+  /// keyframe (the paper's scan-to-scan chaining).
+  double keyframe_distance = 0.0;  ///< m
+  double keyframe_angle = 0.0;     ///< rad
 };
 
 struct Scan2DStats {
@@ -43,7 +48,8 @@ class Mapper2D {
 
  private:
   Mapper2DConfig config_;
-  Scan2D previous_;
+  Scan2D keyframe_;
+  Pose2 keyframe_pose_ = Pose2::Identity();
   Pose2 pose_ = Pose2::Identity(), motion_ = Pose2::Identity();
   std::size_t scans_ = 0;
   Scan2DStats stats_;

@@ -110,10 +110,20 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     std::fprintf(timing, "%zu,%.4f,%d,%zu,%zu,%.6f,%d\n", i, s.ms, s.iterations, s.points, s.pairs,
                  s.error, s.bridged ? 1 : 0);
     std::fflush(timing);
-    grid.insert_scan(pose, scan.points, scan.misses);
+    // A trajectory that ran away (a failed method on hard data) can need more cells than the
+    // grid allows: the run goes on and keeps its poses, without that map.
+    const auto insert = [&](OccupancyGrid& g, std::string& error, const Pose2& at) {
+      if (!error.empty()) return;
+      try {
+        g.insert_scan(at, scan.points, scan.misses);
+      } catch (const Error& e) {
+        error = e.what();
+      }
+    };
+    insert(grid, summary.map_error, pose);
     if (options.reference_map && input.has_reference)
-      reference_grid.insert_scan(reference.front().inverse() * reference.back(), scan.points,
-                                 scan.misses);
+      insert(reference_grid, summary.reference_map_error,
+             reference.front().inverse() * reference.back());
     reference_trajectory.poses.push_back(to_pose3(reference.front().inverse() * reference.back()));
     reference_trajectory.timestamps.push_back(laser.timestamp);
     summary.bridged += s.bridged;
@@ -133,13 +143,16 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     if (summary.scans > 1) summary.one_step = relative_pose_error_2d(reference, estimate, 1);
     if (summary.scans > 10) summary.ten_steps = relative_pose_error_2d(reference, estimate, 10);
   }
-  if (summary.scans > 0) {
+  if (summary.scans > 0 && summary.map_error.empty()) {
+    grid.crop_to_observed();
     grid.write_map_server(file("map.pgm"));
     grid.write_png(file("map.png"));
-    if (options.reference_map && input.has_reference) {
-      reference_grid.write_map_server(file("map_reference.pgm"));
-      reference_grid.write_png(file("map_reference.png"));
-    }
+  }
+  if (summary.scans > 0 && options.reference_map && input.has_reference &&
+      summary.reference_map_error.empty()) {
+    reference_grid.crop_to_observed();
+    reference_grid.write_map_server(file("map_reference.pgm"));
+    reference_grid.write_png(file("map_reference.png"));
   }
   const Registration2DOptions& r = options.mapper.registration;
   nlohmann::ordered_json j;
@@ -164,6 +177,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   j["mean_ms"] = summary.mean_ms;
   j["max_ms"] = summary.max_ms;
   j["scans_per_second"] = summary.scans_per_second;
+  if (!summary.map_error.empty()) j["map_error"] = summary.map_error;
   if (summary.one_step.pairs > 0) j["relative_error_1"] = error_json(summary.one_step);
   if (summary.ten_steps.pairs > 0) j["relative_error_10"] = error_json(summary.ten_steps);
   write_file_atomic(file("summary.json"), j.dump(2) + "\n");

@@ -40,6 +40,8 @@ struct Map2DSummary {
   double mean_ms = 0, max_ms = 0, scans_per_second = 0;
   bool interrupted = false, has_reference = false;
   RelativeError2D one_step, ten_steps;
+  /// Why map.* (or map_reference.*) was not written, e.g. a trajectory too large for the grid.
+  std::string map_error, reference_map_error;
 };
 
 /// Writes RUNDIR/poses_tum.txt and timing.csv (flushed per scan), poses_reference_tum.txt,

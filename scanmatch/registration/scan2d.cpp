@@ -57,7 +57,8 @@ class NearestNeighbours2D {
 };
 
 CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
-                              double max_distance, const NearestNeighbours2D* reference_tree);
+                              double max_distance,
+                              std::optional<NearestNeighbours2D>* reference_tree);
 
 std::pair<std::size_t, double> brute_force_nearest(const Points2& points, const Vec2& q) {
   std::size_t best = 0;
@@ -243,13 +244,18 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
 }
 
 // The nearest point to `p` on the segments from reference point j to its beam-order neighbours
-// (segments longer than `max_length` span a gap, not a surface, and are not used).
-Vec2 project_onto_neighbour_segments(const Scan2D& reference, std::size_t j, const Vec2& p,
-                                     double max_length) {
+// (segments longer than `max_length` span a gap, not a surface, and are not used). Empty when j
+// ends a surface and `p` lies beyond that end: such a point has no counterpart in the reference
+// (the edge of the range, an occlusion), and pairing it with the end would pull the scan back
+// along the surface, a bias that builds up along a corridor.
+std::optional<Vec2> project_onto_neighbour_segments(const Scan2D& reference, std::size_t j,
+                                                    const Vec2& p, double max_length) {
   const std::size_t m = reference.points.size();
   const Vec2& q = reference.points[j];
   Vec2 best = q;
   double best_squared = (p - q).squaredNorm();
+  int segments = 0;
+  bool beyond = false;
   for (const long step : {-1L, 1L}) {
     long k = static_cast<long>(j) + step;
     if (reference.circular) k = (k + static_cast<long>(m)) % static_cast<long>(m);
@@ -257,14 +263,17 @@ Vec2 project_onto_neighbour_segments(const Scan2D& reference, std::size_t j, con
     const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
     const double length_squared = d.squaredNorm();
     if (length_squared < 1e-18 || length_squared > max_length * max_length) continue;
-    const double s = std::clamp((p - q).dot(d) / length_squared, 0.0, 1.0);
-    const Vec2 candidate = q + s * d;
+    ++segments;
+    const double along = (p - q).dot(d) / length_squared;
+    beyond = along < 0.0;
+    const Vec2 candidate = q + std::clamp(along, 0.0, 1.0) * d;
     const double squared = (p - candidate).squaredNorm();
     if (squared < best_squared) {
       best_squared = squared;
       best = candidate;
     }
   }
+  if (segments == 1 && beyond) return std::nullopt;
   return best;
 }
 
@@ -306,7 +315,7 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
   Pairs pairs;
   Points2 line_points, normals;
   const bool point_to_line = o.sparse_step == "point-to-line";
-  const NearestNeighbours2D tree(reference.points);
+  std::optional<NearestNeighbours2D> tree;
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
     const Points2 moved = transformed(current.points, r.transform);
     const CorrespondencePath path = trace_path(moved, reference.points, reference.circular,
@@ -320,8 +329,10 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
       if (!path.valid[i]) continue;
       const std::size_t j = static_cast<std::size_t>(path.row[i]);
       if (point_to_line) {
-        const Vec2 q =
+        const std::optional<Vec2> projected =
             project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
+        if (!projected) continue;
+        const Vec2 q = *projected;
         const Vec2 normal = segment_normal(reference, j, q, o.max_correspondence_distance);
         if (normal.isZero()) continue;
         pairs.from.push_back(current.points[i]);
@@ -331,10 +342,13 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
         pairs.distance_sum += std::abs(normal.dot(moved[i] - reference.points[j]));
         continue;
       }
-      const Vec2 q = o.subsample_projection
-                         ? project_onto_neighbour_segments(reference, j, moved[i],
-                                                           o.max_correspondence_distance)
-                         : reference.points[j];
+      Vec2 q = reference.points[j];
+      if (o.subsample_projection) {
+        const std::optional<Vec2> projected =
+            project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
+        if (!projected) continue;
+        q = *projected;
+      }
       pairs.from.push_back(current.points[i]);
       pairs.to.push_back(q);
       pairs.distance_sum += (moved[i] - q).norm();
@@ -346,7 +360,7 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
     const Pose2 step = next * r.transform.inverse();
     r.transform = next;
     r.error = pairs.distance_sum / static_cast<double>(r.pairs);
-    if (small_step(step, o.tolerance)) {
+    if (small_step(step, std::max(o.tolerance, o.sparse_tolerance))) {
       r.converged = true;
       break;
     }
@@ -444,7 +458,8 @@ CorrespondencePath correspondence_path(const Points2& current, const Points2& re
 
 namespace {
 CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
-                              double max_distance, const NearestNeighbours2D* reference_tree) {
+                              double max_distance,
+                              std::optional<NearestNeighbours2D>* reference_tree) {
   const long n = static_cast<long>(current.size()), m = static_cast<long>(reference.size());
   CorrespondencePath path;
   path.row.assign(static_cast<std::size_t>(n), 0);
@@ -455,8 +470,11 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
     return std::abs(d.x()) + std::abs(d.y());
   };
   const auto column_minimum = [&](long i) {
-    if (reference_tree)  // the Euclidean nearest: the Manhattan minimum or next to it
-      return static_cast<long>(reference_tree->nearest(current[static_cast<std::size_t>(i)]).first);
+    if (reference_tree) {  // the Euclidean nearest: the Manhattan minimum or next to it
+      if (!reference_tree->has_value()) reference_tree->emplace(reference);  // built when needed
+      return static_cast<long>(
+          (*reference_tree)->nearest(current[static_cast<std::size_t>(i)]).first);
+    }
     long best = 0;
     for (long j = 1; j < m; ++j)
       if (distance(i, j) < distance(i, best)) best = j;

@@ -64,7 +64,12 @@ struct Registration2DOptions {
   bool subsample_projection = true;
   /// sparse-icp's step on the kept pairs: "svd" (the paper: point-to-point, closed form) or
   /// "point-to-line" (Censi's closed form against the reference segment of each kept pair).
-  std::string sparse_step = "svd";
+  std::string sparse_step = "point-to-line";
+  /// sparse-icp stops at steps below this (m and rad) or `tolerance`, whichever is larger. Near
+  /// the optimum the kept set gains or loses a pair or two each iteration, which moves the
+  /// solution by about 0.1 mm, so a tighter stop only spins: on 300 simulated pairs 1e-3 gave
+  /// 4.87 mm in 7 iterations, 1e-4 4.94 mm in 33.
+  double sparse_tolerance = 1e-3;
   double normal_angle = 30.0 * M_PI / 180;  ///< rad, normal-icp's rejection threshold
   /// pl-icp: the worst pairs beyond this fraction are dropped each iteration (Censi's csm keeps
   /// 95 %).
