@@ -19,11 +19,11 @@ extern "C" void on_map2d_interrupt(int) {
 }
 
 struct Map2DCommand {
-  std::string sequence, out, initial = "constant-velocity";
+  std::string sequence, out, initial = "identity";
   std::size_t scans = 0;
   std::uint64_t seed = 1;
   bool no_motion_distortion = false;
-  double search_angle_deg = 25.0, keyframe_angle_deg = 0.0;
+  double search_angle_deg = 45.0, keyframe_angle_deg = 0.0;
   Map2DRunOptions run;
 };
 
@@ -32,6 +32,8 @@ struct Map2DCommand {
 void add_map2d_command(CLI::App& app) {
   auto c = std::make_shared<Map2DCommand>();
   Registration2DOptions& r = c->run.mapper.registration;
+  // Scans of the classic logs are up to 1.5 m and 78 deg apart: the search is on by default.
+  r.search_window = 1.3;
   auto* cmd =
       app.add_subcommand("map2d", "2D laser scan-to-scan mapping: poses and an occupancy grid");
   cmd->add_option("SEQUENCE", c->sequence,

@@ -240,7 +240,8 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
 
   if (ctf) {
     const auto map_start = Clock::now();
-    if (config_.map_update) {
+    // --no-fine: nothing reads the global map, so it is not built (nor timed).
+    if (config_.fine_stage && config_.map_update) {
       // Points beyond the radius would be pruned anyway: keep them out so the bound is strict.
       bool beyond = false;
       const double r2 = config_.map_radius * config_.map_radius;
@@ -252,7 +253,7 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
         map_.remove_far(estimate.translation(), config_.map_radius);
         last_prune_ = estimate.translation();
       }
-    } else if (down.size() > 0) {
+    } else if (config_.fine_stage && down.size() > 0) {
       // Ablation: the fine stage sees only the previous frame (no map building or update).
       map_ = GaussianVoxelMap(map_options(config_));
       map_.insert(down, estimate);

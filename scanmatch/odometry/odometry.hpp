@@ -55,7 +55,8 @@ struct OdometryConfig {
   bool map_update = true;
   /// Constant-velocity motion prior; false: the previous pose is the initial guess.
   bool constant_velocity = true;
-  /// Move each point to the frame start with the constant-velocity motion (needs point times).
+  /// Move each point to the frame's middle with the constant-velocity motion (needs point times);
+  /// the reported poses are still frame-start poses.
   bool deskew = true;
   /// Frames whose motion prior is below both thresholds are not deskewed: their distortion is
   /// below the sensor noise, and deskewing by a velocity that is itself estimation noise feeds that

@@ -43,7 +43,7 @@ struct Registration2DOptions {
   double tolerance = 1e-4;  ///< m and rad: stop when a step is smaller than this
   /// m: the paper's threshold D (Manhattan distance) for sparse-icp; the Euclidean rejection
   /// distance of the baselines.
-  double max_correspondence_distance = 0.3;
+  double max_correspondence_distance = 0.5;
   /// sparse-icp coarse stage: the angle histogram's bin width, rad.
   double histogram_bin = 1.0 * M_PI / 180;
   /// sparse-icp coarse stage: histogram segments are extended to at least this length, m (0: the
@@ -78,7 +78,7 @@ struct Registration2DOptions {
   /// below), for steps the local methods cannot bridge (long corridors, fast turns). It replaces
   /// sparse-icp's histogram and centroid stage. 0: off.
   double search_window = 0.0;               ///< m, +- in x and y around the initial guess
-  double search_angle = 25.0 * M_PI / 180;  ///< rad, +- around the initial guess
+  double search_angle = 45.0 * M_PI / 180;  ///< rad, +- around the initial guess
   double search_resolution = 0.05;          ///< m, cells of the search's likelihood grid
 };
 
