@@ -167,7 +167,9 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                s.iterations, s.condition_number, s.degenerate_directions,
                                s.bridged ? 1 : 0));
     }
-    if (options.write_map) {
+    // A bridged frame has no registered points of its own (an empty frame leaves the previous
+    // one in last_frame()); it would only add a copy or a guess to the map.
+    if (options.write_map && !s.bridged) {
       map.add(odometry.last_frame(), odometry.world_from_map() * odometry.last_internal_pose());
       if (options.map_export_radius > 0.0 && summary.frames % 50 == 0)
         map.keep_within(pose.translation(), options.map_export_radius);
