@@ -48,7 +48,10 @@ double histogram_rotation(const std::vector<double>& current, const std::vector<
   std::vector<double> w(n, 0.0);
   for (std::size_t shift = 0; shift < n; ++shift) {
     if (!allowed(shift) && !allowed((shift + 1) % n) && !allowed((shift + n - 1) % n)) continue;
-    for (std::size_t i = 0; i < n; ++i) w[shift] += current[i] * reference[(i + shift) % n];
+    double sum = 0.0;  // two plain loops instead of a modulo per bin
+    for (std::size_t i = 0; i + shift < n; ++i) sum += current[i] * reference[i + shift];
+    for (std::size_t i = n - shift; i < n; ++i) sum += current[i] * reference[i + shift - n];
+    w[shift] = sum;
   }
   std::size_t best = 0;
   for (std::size_t s = 1; s < n; ++s)

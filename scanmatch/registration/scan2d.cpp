@@ -498,27 +498,36 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
   std::vector<double> best_distance(static_cast<std::size_t>(n));
   long j = column_minimum(0);
   for (long i = 0; i < n; ++i) {
+    double d = distance(i, j);
     if (i > 0) {
       // The 3x1 window slides from the previous row towards decreasing distance.
       for (long moves = 0; moves < m; ++moves) {
         long best = j;
+        double best_d = d;
         for (const long step : {-1L, 1L}) {
           const long k = neighbour(j, step);
-          if (k >= 0 && distance(i, k) < distance(i, best)) best = k;
+          if (k < 0) continue;
+          const double dk = distance(i, k);
+          if (dk < best_d) {
+            best = k;
+            best_d = dk;
+          }
         }
         if (best == j) break;
         j = best;
+        d = best_d;
       }
-      if (distance(i, j) > max_distance) {  // lost: pick the path up again, then settle
+      if (d > max_distance) {  // lost: pick the path up again, then settle
         j = column_minimum(i);
         for (const long step : {-1L, 1L}) {
           const long k = neighbour(j, step);
           if (k >= 0 && distance(i, k) < distance(i, j)) j = k;
         }
+        d = distance(i, j);
       }
     }
     path.row[static_cast<std::size_t>(i)] = static_cast<int>(j);
-    best_distance[static_cast<std::size_t>(i)] = distance(i, j);
+    best_distance[static_cast<std::size_t>(i)] = d;
   }
   // Invalid pairs: abnormal steps (repeat = many-to-one, skip = one-to-many, backwards, jumps),
   // shared reference points and distances above the threshold. What is left is one-to-one.
