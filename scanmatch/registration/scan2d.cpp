@@ -79,6 +79,15 @@ Points2 transformed(const Points2& points, const Pose2& T) {
   return out;
 }
 
+/// Index of the beam-order neighbour of j (step -1 or +1), wrapping on a circular scan; -1 past
+/// the ends of an open one.
+long beam_neighbour(const Scan2D& scan, std::size_t j, long step) {
+  const long m = static_cast<long>(scan.points.size());
+  long k = static_cast<long>(j) + step;
+  if (scan.circular) k = (k + m) % m;
+  return k < 0 || k >= m ? -1 : k;
+}
+
 Vec2 centroid(const Points2& points) {
   Vec2 c = Vec2::Zero();
   for (const Vec2& p : points) c += p;
@@ -171,7 +180,6 @@ Registration2DResult point_to_point_icp(const Scan2D& current, const Scan2D& ref
 Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& reference,
                                        const Registration2DOptions& o, const Pose2& initial) {
   const NearestNeighbours2D tree(reference.points);
-  const std::size_t m = reference.points.size();
   const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
   struct LinePair {
     Vec2 point, on_line, normal;
@@ -192,10 +200,8 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
       double best = std::numeric_limits<double>::infinity();
       std::size_t k = j;
       for (const long step : {-1L, 1L}) {
-        long candidate = static_cast<long>(j) + step;
-        if (reference.circular)
-          candidate = (candidate + static_cast<long>(m)) % static_cast<long>(m);
-        if (candidate < 0 || candidate >= static_cast<long>(m)) continue;
+        const long candidate = beam_neighbour(reference, j, step);
+        if (candidate < 0) continue;
         const double d = (reference.points[static_cast<std::size_t>(candidate)] - p).squaredNorm();
         if (d < best) {
           best = d;
@@ -250,16 +256,14 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
 // along the surface, a bias that builds up along a corridor.
 std::optional<Vec2> project_onto_neighbour_segments(const Scan2D& reference, std::size_t j,
                                                     const Vec2& p, double max_length) {
-  const std::size_t m = reference.points.size();
   const Vec2& q = reference.points[j];
   Vec2 best = q;
   double best_squared = (p - q).squaredNorm();
   int segments = 0;
   bool beyond = false;
   for (const long step : {-1L, 1L}) {
-    long k = static_cast<long>(j) + step;
-    if (reference.circular) k = (k + static_cast<long>(m)) % static_cast<long>(m);
-    if (k < 0 || k >= static_cast<long>(m)) continue;
+    const long k = beam_neighbour(reference, j, step);
+    if (k < 0) continue;
     const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
     const double length_squared = d.squaredNorm();
     if (length_squared < 1e-18 || length_squared > max_length * max_length) continue;
@@ -281,14 +285,12 @@ std::optional<Vec2> project_onto_neighbour_segments(const Scan2D& reference, std
 // no usable neighbour).
 Vec2 segment_normal(const Scan2D& reference, std::size_t j, const Vec2& on_segment,
                     double max_length) {
-  const std::size_t m = reference.points.size();
   const Vec2& q = reference.points[j];
   Vec2 best = Vec2::Zero();
   double best_distance = std::numeric_limits<double>::infinity();
   for (const long step : {-1L, 1L}) {
-    long k = static_cast<long>(j) + step;
-    if (reference.circular) k = (k + static_cast<long>(m)) % static_cast<long>(m);
-    if (k < 0 || k >= static_cast<long>(m)) continue;
+    const long k = beam_neighbour(reference, j, step);
+    if (k < 0) continue;
     const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
     const double length = d.norm();
     if (length < 1e-9 || length > max_length) continue;
