@@ -131,6 +131,12 @@ TEST(Scan2D, PathDropsOneToManyAndManyToOnePairs) {
                                    true, true, false, true,  true,  true};
   EXPECT_EQ(path.row, rows);
   EXPECT_EQ(path.valid, valid);
+  // Relaxed rules: of the two columns on reference 3 the nearer (current 3) keeps it, and the
+  // skip over reference 7 is a normal step.
+  const CorrespondencePath relaxed = correspondence_path(current, reference, false, 0.05, 2, true);
+  const std::vector<bool> relaxed_valid = {true, true, true, true, false, true,
+                                           true, true, true, true, true,  true};
+  EXPECT_EQ(relaxed.valid, relaxed_valid);
   // Beyond the distance threshold D nothing is kept.
   std::vector<Vec2> far;
   for (const Vec2& p : current) far.push_back(p + Vec2(0, 0.2));

@@ -58,7 +58,8 @@ class NearestNeighbours2D {
 
 CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
                               double max_distance,
-                              std::optional<NearestNeighbours2D>* reference_tree);
+                              std::optional<NearestNeighbours2D>* reference_tree, long max_step = 1,
+                              bool keep_nearest_shared = false);
 
 std::pair<std::size_t, double> brute_force_nearest(const Points2& points, const Vec2& q) {
   std::size_t best = 0;
@@ -320,8 +321,9 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
   std::optional<NearestNeighbours2D> tree;
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
     const Points2 moved = transformed(current.points, r.transform);
-    const CorrespondencePath path = trace_path(moved, reference.points, reference.circular,
-                                               o.max_correspondence_distance, &tree);
+    const CorrespondencePath path =
+        trace_path(moved, reference.points, reference.circular, o.max_correspondence_distance,
+                   &tree, o.path_max_step, o.path_keep_nearest_shared);
     pairs.clear();
     if (point_to_line) {
       line_points.clear();
@@ -454,14 +456,17 @@ Pose2 coarse_alignment_2d(const Points2& current, const Points2& reference, doub
 }
 
 CorrespondencePath correspondence_path(const Points2& current, const Points2& reference,
-                                       bool circular, double max_distance) {
-  return trace_path(current, reference, circular, max_distance, nullptr);
+                                       bool circular, double max_distance, long max_step,
+                                       bool keep_nearest_shared) {
+  return trace_path(current, reference, circular, max_distance, nullptr, max_step,
+                    keep_nearest_shared);
 }
 
 namespace {
 CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
                               double max_distance,
-                              std::optional<NearestNeighbours2D>* reference_tree) {
+                              std::optional<NearestNeighbours2D>* reference_tree, long max_step,
+                              bool keep_nearest_shared) {
   const long n = static_cast<long>(current.size()), m = static_cast<long>(reference.size());
   CorrespondencePath path;
   path.row.assign(static_cast<std::size_t>(n), 0);
@@ -533,16 +538,30 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
   }
   // Invalid pairs: abnormal steps (repeat = many-to-one, skip = one-to-many, backwards, jumps),
   // shared reference points and distances above the threshold. What is left is one-to-one.
+  // Relaxed (not the paper): a skip of up to `max_step` rows is normal, and of the columns that
+  // share a row the nearest keeps it.
+  const auto at = [&](long k) { return static_cast<long>(path.row[static_cast<std::size_t>(k)]); };
+  const auto dist = [&](long k) { return best_distance[static_cast<std::size_t>(k)]; };
   for (long i = 0; i < n; ++i) {
-    const auto at = [&](long k) {
-      return static_cast<long>(path.row[static_cast<std::size_t>(k)]);
+    const auto normal_step = [&](long from, long to) {
+      const long d = row_step(at(from), at(to));
+      return d >= 1 && d <= max_step;
     };
-    const bool normal_before = i > 0 && row_step(at(i - 1), at(i)) == 1;
-    const bool normal_after = i + 1 < n && row_step(at(i), at(i + 1)) == 1;
-    const bool shared = (i > 0 && at(i - 1) == at(i)) || (i + 1 < n && at(i + 1) == at(i));
-    const bool normal = i > 0 ? normal_before : normal_after;
-    path.valid[static_cast<std::size_t>(i)] =
-        normal && !shared && best_distance[static_cast<std::size_t>(i)] <= max_distance;
+    bool normal = i > 0 ? normal_step(i - 1, i) : (i + 1 < n && normal_step(i, i + 1));
+    bool shared = (i > 0 && at(i - 1) == at(i)) || (i + 1 < n && at(i + 1) == at(i));
+    if (keep_nearest_shared && shared) {
+      // The run of columns on this row; the nearest one keeps the pair.
+      long first = i, last = i;
+      while (first > 0 && at(first - 1) == at(i)) --first;
+      while (last + 1 < n && at(last + 1) == at(i)) ++last;
+      long nearest = first;
+      for (long k = first + 1; k <= last; ++k)
+        if (dist(k) < dist(nearest)) nearest = k;
+      shared = nearest != i;
+      normal = (first == 0 || normal_step(first - 1, first)) ||
+               (last + 1 < n && normal_step(last, last + 1));
+    }
+    path.valid[static_cast<std::size_t>(i)] = normal && !shared && dist(i) <= max_distance;
   }
   return path;
 }

@@ -70,6 +70,13 @@ struct Registration2DOptions {
   /// solution by about 0.1 mm, so a tighter stop only spins: on 300 simulated pairs 1e-3 gave
   /// 4.87 mm in 7 iterations, 1e-4 4.94 mm in 33.
   double sparse_tolerance = 1e-3;
+  /// sparse-icp's invalid-pair rules. The paper keeps a pair only after the normal step (the
+  /// next reference index, `path_max_step` 1) and drops every pair whose reference point is
+  /// shared. Relaxed: steps of up to `path_max_step` rows are normal (a reference point skipped
+  /// where the current scan is sparser), and of the columns sharing a row the nearest keeps it.
+  /// Both keep the pairs one-to-one.
+  long path_max_step = 1;
+  bool path_keep_nearest_shared = false;
   double normal_angle = 30.0 * M_PI / 180;  ///< rad, normal-icp's rejection threshold
   /// pl-icp: the worst pairs beyond this fraction are dropped each iteration (Censi's csm keeps
   /// 95 %).
@@ -122,9 +129,12 @@ struct CorrespondencePath {
 /// point is not shared with a neighbouring column (many-to-one), and its Manhattan distance is at
 /// most `max_distance`. Where the window loses the surface (distance above `max_distance`), the
 /// column is searched in full once to pick the path up again. O(n + m) for overlapping scans.
+/// `max_step` and `keep_nearest_shared` relax the rules as Registration2DOptions::path_max_step
+/// and path_keep_nearest_shared describe (1 and false: the paper).
 CorrespondencePath correspondence_path(const std::vector<Eigen::Vector2d>& current,
                                        const std::vector<Eigen::Vector2d>& reference, bool circular,
-                                       double max_distance);
+                                       double max_distance, long max_step = 1,
+                                       bool keep_nearest_shared = false);
 
 /// Closed-form point-to-line step (Censi 2008): the transform minimising
 /// sum (n_i . (R p_i + t - q_i))^2 exactly, through the Lagrange multiplier of the constraint
