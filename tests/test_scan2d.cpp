@@ -177,9 +177,17 @@ TEST(Scan2D, SparseIcpRecoversAKnownPoseExactlyOnNoiselessData) {
 
 TEST(Scan2D, EveryMethodRecoversSimulatedScanPairs) {
   const auto simulated = pairs(60);
-  for (const std::string& method : registration_2d_method_names()) {
+  std::vector<std::string> methods = registration_2d_method_names();
+  methods.push_back("sparse-icp relaxed");  // relaxed path rules and trimming
+  for (const std::string& method : methods) {
     Registration2DOptions o;
     o.method = method;
+    if (method == "sparse-icp relaxed") {
+      o.method = "sparse-icp";
+      o.path_max_step = 2;
+      o.path_keep_nearest_shared = true;
+      o.sparse_keep_fraction = 0.95;
+    }
     double sum = 0.0;
     std::size_t failures = 0;
     for (const auto& p : simulated) {

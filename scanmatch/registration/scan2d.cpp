@@ -357,6 +357,31 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
       pairs.to.push_back(q);
       pairs.distance_sum += (moved[i] - q).norm();
     }
+    if (point_to_line && o.sparse_keep_fraction < 1.0 && pairs.from.size() > 3) {
+      // Drop the worst residuals beyond keep_fraction, as PL-ICP does.
+      std::vector<double> residual(pairs.from.size());
+      for (std::size_t k = 0; k < residual.size(); ++k)
+        residual[k] = std::abs(normals[k].dot(r.transform * pairs.from[k] - line_points[k]));
+      std::vector<double> sorted = residual;
+      const std::size_t keep = std::max<std::size_t>(
+          3, static_cast<std::size_t>(o.sparse_keep_fraction * static_cast<double>(sorted.size())));
+      std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(keep - 1),
+                       sorted.end());
+      const double limit = sorted[keep - 1];
+      std::size_t w = 0;
+      for (std::size_t k = 0; k < residual.size(); ++k) {
+        if (residual[k] > limit) continue;
+        pairs.from[w] = pairs.from[k];
+        pairs.to[w] = pairs.to[k];
+        line_points[w] = line_points[k];
+        normals[w] = normals[k];
+        ++w;
+      }
+      pairs.from.resize(w);
+      pairs.to.resize(w);
+      line_points.resize(w);
+      normals.resize(w);
+    }
     r.pairs = pairs.from.size();
     if (r.pairs < 3) break;
     const Pose2 next = point_to_line ? solve_point_to_line(pairs.from, line_points, normals)

@@ -76,6 +76,9 @@ struct Registration2DOptions {
   /// where the current scan is sparser), and of the columns sharing a row the nearest keeps it.
   /// Both keep the pairs one-to-one.
   long path_max_step = 1;
+  /// sparse-icp with the point-to-line step: the worst residuals beyond this fraction of the kept
+  /// pairs are dropped each iteration (1: none, the paper).
+  double sparse_keep_fraction = 1.0;
   bool path_keep_nearest_shared = false;
   double normal_angle = 30.0 * M_PI / 180;  ///< rad, normal-icp's rejection threshold
   /// pl-icp: the worst pairs beyond this fraction are dropped each iteration (Censi's csm keeps
