@@ -11,7 +11,8 @@
 //
 // Degeneracy: the fine stage's information matrix is analysed each frame (solver.hpp,
 // analyse_degeneracy); along directions it does not constrain (a plain corridor's axis) the
-// solver makes no update and the pose keeps the constant-velocity prior there.
+// solver makes no update and the pose keeps the fine stage's start there (the coarse NDT result,
+// itself started from the constant-velocity prior).
 
 #include <cstddef>
 #include <string>
