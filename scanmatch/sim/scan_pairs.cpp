@@ -1,9 +1,7 @@
 #include "scanmatch/sim/scan_pairs.hpp"
 
-#include <unistd.h>
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/trajectory.hpp"
@@ -35,7 +33,7 @@ double median_range(const LaserScan2D& scan) {
 
 std::vector<PlanarScanPair> planar_scan_pairs(const PlanarPairOptions& options) {
   if (options.count == 0) return {};
-  // The simulator renders a replayed trajectory: reference and current poses alternate, each
+  // The simulator replays a trajectory in which reference and current poses alternate, each
   // measured from its frame's start pose (no distortion). The replay is anchored at the scene's
   // loop start, so the first pose is that start and every later one is absolute.
   const World world = make_rooms_2d(options.seed);
@@ -58,33 +56,22 @@ std::vector<PlanarScanPair> planar_scan_pairs(const PlanarPairOptions& options) 
     trajectory.poses.push_back(from_xyz_rpy(a.x(), a.y(), 0, 0, 0, yaw));
     trajectory.poses.push_back(from_xyz_rpy(b.x(), b.y(), 0, 0, 0, yaw_b));
   }
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("scanmatch_pairs_" + std::to_string(::getpid()) +
-                                                 "_" + std::to_string(options.seed) + ".txt"))
-          .string();
-  write_trajectory(path, trajectory, TrajectoryFormat::kKitti);
   SimOptions o;
   o.preset = "room-2d";
   o.seed = options.seed;
   o.motion_distortion = false;
   o.noise = options.noise;
-  o.trajectory_file = path;
   o.frames = trajectory.size();
+  o.trajectory = std::move(trajectory);
+  const Simulator simulator(o);
   std::vector<PlanarScanPair> pairs;
-  try {
-    const Simulator simulator(o);
-    for (std::size_t i = 1; i + 1 < simulator.size() && pairs.size() < options.count; i += 2) {
-      PlanarScanPair p{simulator.scan_2d(i), simulator.scan_2d(i + 1),
-                       planar(simulator.pose(i)).inverse() * planar(simulator.pose(i + 1))};
-      // Inside a piece of furniture every return is a few centimetres away.
-      if (median_range(p.reference) < 0.8 || median_range(p.current) < 0.8) continue;
-      pairs.push_back(std::move(p));
-    }
-  } catch (...) {
-    std::filesystem::remove(path);
-    throw;
+  for (std::size_t i = 1; i + 1 < simulator.size() && pairs.size() < options.count; i += 2) {
+    PlanarScanPair p{simulator.scan_2d(i), simulator.scan_2d(i + 1),
+                     planar(simulator.pose(i)).inverse() * planar(simulator.pose(i + 1))};
+    // Inside a piece of furniture every return is a few centimetres away.
+    if (median_range(p.reference) < 0.8 || median_range(p.current) < 0.8) continue;
+    pairs.push_back(std::move(p));
   }
-  std::filesystem::remove(path);
   if (pairs.size() < options.count)
     throw Error("planar scan pairs: only " + std::to_string(pairs.size()) + " of " +
                 std::to_string(options.count) + " usable pairs");

@@ -81,12 +81,14 @@ Simulator::Simulator(const SimOptions& options)
   const double duration = static_cast<double>(std::max(frames_, preset_->frames)) * period + period;
   const Ground* ground = world_.scene.ground();
   const double height = sensor_height(*preset_);
-  if (!options.trajectory_file.empty()) {
+  if (options.trajectory || !options.trajectory_file.empty()) {
     const Pose start = from_xyz_rpy(
         world_.loop.front().x(), world_.loop.front().y(),
         height + (ground ? ground->height(world_.loop.front().x(), world_.loop.front().y()) : 0.0),
         0, 0, 0);
-    motion_ = replay(read_trajectory(options.trajectory_file), start, sensor_->rate_hz);
+    motion_ =
+        replay(options.trajectory ? *options.trajectory : read_trajectory(options.trajectory_file),
+               start, sensor_->rate_hz);
     frames_ = std::min(frames_, static_cast<std::size_t>(motion_.duration() / period) + 1);
   } else if (preset_->motion == "still") {
     const Eigen::Vector3d& s = world_.still_position;

@@ -10,6 +10,7 @@
 
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/sequence.hpp"
+#include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/sim/motion.hpp"
 #include "scanmatch/sim/sensor.hpp"
 #include "scanmatch/sim/worlds.hpp"
@@ -24,6 +25,8 @@ struct SimOptions {
   bool motion_distortion = true;  ///< each point measured from the pose at its own time
   bool noise = true;              ///< range noise and dropouts
   std::string trajectory_file;    ///< replay this KITTI/TUM trajectory instead of the preset's path
+  /// Replay this trajectory (anchored like trajectory_file); wins over trajectory_file.
+  std::optional<Trajectory> trajectory;
 };
 
 struct PresetInfo {
