@@ -18,28 +18,11 @@ void check_same_size(const std::vector<Pose>& a, const std::vector<Pose>& b, con
   if (a.empty()) fail(what, "no poses to evaluate");
 }
 
-double median_of(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const std::size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
-  double m = values[mid];
-  if (values.size() % 2 == 0) {
-    m = 0.5 *
-        (m + *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid)));
-  }
-  return m;
-}
-
 double rms(const std::vector<double>& values) {
   if (values.empty()) return 0.0;
   double sum = 0.0;
   for (double v : values) sum += v * v;
   return std::sqrt(sum / static_cast<double>(values.size()));
-}
-
-double mean(const std::vector<double>& values) {
-  if (values.empty()) return 0.0;
-  return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
 }
 
 // Rotation angle as the KITTI devkit computes it (acos of the clamped trace term).
@@ -54,10 +37,10 @@ RpeResult summarise_rpe(const std::vector<double>& translation,
   RpeResult r;
   r.pairs = translation.size();
   r.translation_rmse = rms(translation);
-  r.translation_mean = mean(translation);
+  r.translation_mean = mean_of(translation);
   r.translation_median = median_of(translation);
   r.rotation_rmse = rms(rotation);
-  r.rotation_mean = mean(rotation);
+  r.rotation_mean = mean_of(rotation);
   return r;
 }
 
@@ -70,6 +53,23 @@ void add_relative_error(const std::vector<Pose>& gt, const std::vector<Pose>& es
 }
 
 }  // namespace
+
+double median_of(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const std::size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
+  double m = values[mid];
+  if (values.size() % 2 == 0) {
+    m = 0.5 *
+        (m + *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid)));
+  }
+  return m;
+}
+
+double mean_of(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+}
 
 Alignment parse_alignment(const std::string& name) {
   if (name == "none") return Alignment::kNone;
@@ -118,7 +118,7 @@ AteResult compute_ate(const std::vector<Pose>& ground_truth, const std::vector<P
     errors.push_back((aligned - gt_positions[i]).norm());
   }
   r.rmse = rms(errors);
-  r.mean = mean(errors);
+  r.mean = mean_of(errors);
   r.median = median_of(errors);
   r.max = *std::max_element(errors.begin(), errors.end());
   r.final_drift = errors.back();

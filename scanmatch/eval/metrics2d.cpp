@@ -4,19 +4,9 @@
 #include <cmath>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/eval/metrics.hpp"
 
 namespace scanmatch {
-namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), middle, v.end());
-  if (v.size() % 2 == 1) return *middle;
-  return 0.5 * (*middle + *std::max_element(v.begin(), middle));
-}
-
-}  // namespace
 
 RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
                                        const std::vector<Pose2>& estimate, std::size_t step,
@@ -41,15 +31,10 @@ RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
   }
   r.pairs = translation.size();
   if (r.pairs == 0) return r;
-  const auto mean = [](const std::vector<double>& v) {
-    double s = 0.0;
-    for (double x : v) s += x;
-    return s / static_cast<double>(v.size());
-  };
-  r.mean_translation = mean(translation);
-  r.mean_rotation = mean(rotation);
-  r.median_translation = median(translation);
-  r.median_rotation = median(rotation);
+  r.mean_translation = mean_of(translation);
+  r.mean_rotation = mean_of(rotation);
+  r.median_translation = median_of(translation);
+  r.median_rotation = median_of(rotation);
   r.max_translation = *std::max_element(translation.begin(), translation.end());
   r.max_rotation = *std::max_element(rotation.begin(), rotation.end());
   r.failure_rate = static_cast<double>(failures) / static_cast<double>(r.pairs);
