@@ -34,10 +34,6 @@ struct ScanPair {
   Pose2 truth;  ///< maps current into reference
 };
 
-Pose2 planar(const Eigen::Vector3d& xytheta) {
-  return pose2(xytheta.x(), xytheta.y(), xytheta.z());
-}
-
 std::vector<ScanPair> simulated_pairs(std::size_t count, double max_translation,
                                       double max_rotation) {
   sim::PlanarPairOptions options;
@@ -136,7 +132,7 @@ std::string log_table(const std::string& path, const Bench2DOptions& o) {
   std::vector<Pose2> reference;
   for (const LaserScan2D& s : log.scans) {
     scans.push_back(scan_from_laser(s));
-    reference.push_back(planar(s.pose));
+    reference.push_back(pose2(s.pose));
   }
   std::string md = fmt::format(
       "### {} ({} scans)\n\nRelative pose error against the corrected poses of the log, over 1 and "
@@ -212,11 +208,8 @@ void add_bench2d_command(CLI::App& app) {
       o->methods = registration_2d_method_names();
       o->methods.insert(o->methods.begin() + 1, kPaperVariant);
     }
-    for (const auto& m : o->methods) {
-      const auto& names = registration_2d_method_names();
-      if (m != kPaperVariant && std::find(names.begin(), names.end(), m) == names.end())
-        throw Error("bench2d: unknown method '" + m + "'");
-    }
+    for (const auto& m : o->methods)
+      if (m != kPaperVariant) check_registration_2d_method(m);
     std::string md;
     if (o->pairs > 0) {
       md +=

@@ -351,10 +351,7 @@ TEST(Map2D, RegisterAcceptsTwoDimensionalScans) {
   ASSERT_EQ(r.status, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
   const CarmenLog parsed = read_carmen_log(log);
-  const Pose2 truth =
-      pose2(parsed.scans[10].pose.x(), parsed.scans[10].pose.y(), parsed.scans[10].pose.z())
-          .inverse() *
-      pose2(parsed.scans[11].pose.x(), parsed.scans[11].pose.y(), parsed.scans[11].pose.z());
+  const Pose2 truth = pose2(parsed.scans[10].pose).inverse() * pose2(parsed.scans[11].pose);
   EXPECT_NEAR(j["x"].get<double>(), truth.translation().x(), 0.02);
   EXPECT_NEAR(j["y"].get<double>(), truth.translation().y(), 0.02);
   EXPECT_NEAR(j["theta_deg"].get<double>(), degrees(pose2_angle(truth)), 0.5);

@@ -8,9 +8,7 @@
 namespace scanmatch {
 
 Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
-  const auto& names = registration_2d_method_names();
-  if (std::find(names.begin(), names.end(), config.registration.method) == names.end())
-    throw Error("unknown 2D registration method '" + config.registration.method + "'");
+  check_registration_2d_method(config.registration.method);
 }
 
 Pose2 Mapper2D::add_scan(const Scan2D& scan) {

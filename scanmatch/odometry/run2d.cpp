@@ -17,10 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Pose2 planar(const Eigen::Vector3d& xytheta) {
-  return pose2(xytheta.x(), xytheta.y(), xytheta.z());
-}
-
 Pose to_pose3(const Pose2& T) {
   return from_xyz_rpy(T.translation().x(), T.translation().y(), 0, 0, 0, pose2_angle(T));
 }
@@ -105,7 +101,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     const Pose2 pose = mapper.add_scan(scan);
     const Scan2DStats& s = mapper.last_stats();
     estimate.push_back(pose);
-    reference.push_back(planar(laser.pose));
+    reference.push_back(pose2(laser.pose));
     poses.write(to_pose3(pose), laser.timestamp);
     std::fprintf(timing, "%zu,%.4f,%d,%zu,%zu,%.6f,%d\n", i, s.ms, s.iterations, s.points, s.pairs,
                  s.error, s.bridged ? 1 : 0);

@@ -80,13 +80,16 @@ Points2 transformed(const Points2& points, const Pose2& T) {
   return out;
 }
 
-/// Index of the beam-order neighbour of j (step -1 or +1), wrapping on a circular scan; -1 past
-/// the ends of an open one.
-long beam_neighbour(const Scan2D& scan, std::size_t j, long step) {
-  const long m = static_cast<long>(scan.points.size());
-  long k = static_cast<long>(j) + step;
-  if (scan.circular) k = (k + m) % m;
+/// Index of the beam-order neighbour of j (step -1 or +1) in a scan of m points, wrapping on a
+/// circular scan; -1 past the ends of an open one.
+long beam_neighbour(long m, bool circular, long j, long step) {
+  long k = j + step;
+  if (circular) k = (k + m) % m;
   return k < 0 || k >= m ? -1 : k;
+}
+long beam_neighbour(const Scan2D& scan, std::size_t j, long step) {
+  return beam_neighbour(static_cast<long>(scan.points.size()), scan.circular, static_cast<long>(j),
+                        step);
 }
 
 Vec2 centroid(const Points2& points) {
@@ -102,18 +105,63 @@ bool small_step(const Pose2& step, double tolerance) {
 /// Unit normals of a scan from its beam-order neighbours; zero where a point has no neighbour
 /// within `max_gap` on either side (an isolated return has no surface direction).
 Points2 scan_normals(const Points2& points, bool circular, double max_gap) {
-  const std::size_t n = points.size();
-  Points2 normals(n, Vec2::Zero());
-  for (std::size_t i = 0; i < n; ++i) {
-    const bool has_prev = i > 0 || circular, has_next = i + 1 < n || circular;
-    Vec2 a = points[i], b = points[i];
-    if (has_prev && (points[(i + n - 1) % n] - points[i]).norm() < max_gap)
-      a = points[(i + n - 1) % n];
-    if (has_next && (points[(i + 1) % n] - points[i]).norm() < max_gap) b = points[(i + 1) % n];
-    const Vec2 d = b - a;
-    if (d.norm() > 1e-9) normals[i] = Vec2(-d.y(), d.x()).normalized();
+  const long n = static_cast<long>(points.size());
+  Points2 normals(points.size(), Vec2::Zero());
+  for (long i = 0; i < n; ++i) {
+    const Vec2& p = points[static_cast<std::size_t>(i)];
+    Vec2 ends[2] = {p, p};  // the neighbours before and after, where near enough
+    for (int side = 0; side < 2; ++side) {
+      const long k = beam_neighbour(n, circular, i, side == 0 ? -1 : 1);
+      if (k >= 0 && (points[static_cast<std::size_t>(k)] - p).norm() < max_gap)
+        ends[side] = points[static_cast<std::size_t>(k)];
+    }
+    const Vec2 d = ends[1] - ends[0];
+    if (d.norm() > 1e-9) normals[static_cast<std::size_t>(i)] = Vec2(-d.y(), d.x()).normalized();
   }
   return normals;
+}
+
+/// A point of the current scan against a line of the reference: the point (current frame), a
+/// point of the line and its unit normal (reference frame), and the distance at the current pose.
+struct LinePair {
+  Vec2 point, on_line, normal;
+  double distance;
+};
+
+/// Keeps the `fraction` of pairs nearest to their lines (at least three).
+void keep_nearest_fraction(std::vector<LinePair>& pairs, double fraction) {
+  const std::size_t keep = std::max<std::size_t>(
+      3, static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(pairs.size()))));
+  if (keep >= pairs.size()) return;
+  std::nth_element(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
+                   [](const LinePair& a, const LinePair& b) { return a.distance < b.distance; });
+  pairs.resize(keep);
+}
+
+/// Adds one point-to-line pair to the normal equations of the unknowns x = (tx, ty, c, s): the
+/// residual is n . (M x - q) with M = [1 0 px -py; 0 1 py px].
+void add_line_pair(const Vec2& p, const Vec2& on_line, const Vec2& normal, Eigen::Matrix4d& H,
+                   Eigen::Vector4d& g) {
+  Eigen::Matrix<double, 2, 4> M;
+  M << 1, 0, p.x(), -p.y(), 0, 1, p.y(), p.x();
+  const Eigen::Matrix<double, 1, 4> a = normal.transpose() * M;
+  H += a.transpose() * a;
+  g += a.transpose() * normal.dot(on_line);
+}
+
+Pose2 solve_line_normal_equations(const Eigen::Matrix4d& H, const Eigen::Vector4d& g);
+
+/// Censi's closed-form step on the pairs; their mean distance goes to `mean_distance`.
+Pose2 solve_line_pairs(const std::vector<LinePair>& pairs, double& mean_distance) {
+  Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d g = Eigen::Vector4d::Zero();
+  double sum = 0.0;
+  for (const LinePair& pair : pairs) {
+    add_line_pair(pair.point, pair.on_line, pair.normal, H, g);
+    sum += pair.distance;
+  }
+  mean_distance = sum / static_cast<double>(pairs.size());
+  return solve_line_normal_equations(H, g);
 }
 
 struct Pairs {
@@ -182,12 +230,7 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
                                        const Registration2DOptions& o, const Pose2& initial) {
   const NearestNeighbours2D tree(reference.points);
   const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
-  struct LinePair {
-    Vec2 point, on_line, normal;
-    double distance;
-  };
   std::vector<LinePair> pairs;
-  Points2 from, on_line, normals;
   Registration2DResult r;
   r.transform = initial;
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
@@ -217,28 +260,9 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
           {point, reference.points[j], normal, std::abs(normal.dot(p - reference.points[j]))});
     }
     if (pairs.size() < 3) break;
-    const std::size_t keep = std::max<std::size_t>(
-        3,
-        static_cast<std::size_t>(std::ceil(o.keep_fraction * static_cast<double>(pairs.size()))));
-    if (keep < pairs.size()) {
-      std::nth_element(
-          pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
-          [](const LinePair& a, const LinePair& b) { return a.distance < b.distance; });
-      pairs.resize(keep);
-    }
-    from.clear();
-    on_line.clear();
-    normals.clear();
-    double sum = 0.0;
-    for (const LinePair& pair : pairs) {
-      from.push_back(pair.point);
-      on_line.push_back(pair.on_line);
-      normals.push_back(pair.normal);
-      sum += pair.distance;
-    }
+    keep_nearest_fraction(pairs, o.keep_fraction);
     r.pairs = pairs.size();
-    r.error = sum / static_cast<double>(r.pairs);
-    const Pose2 next = solve_point_to_line(from, on_line, normals);
+    const Pose2 next = solve_line_pairs(pairs, r.error);
     const Pose2 step = next * r.transform.inverse();
     r.transform = next;
     if (small_step(step, o.tolerance)) {
@@ -250,15 +274,21 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
   return r;
 }
 
-// The nearest point to `p` on the segments from reference point j to its beam-order neighbours
-// (segments longer than `max_length` span a gap, not a surface, and are not used). Empty when j
-// ends a surface and `p` lies beyond that end: such a point has no counterpart in the reference
-// (the edge of the range, an occlusion), and pairing it with the end would pull the scan back
-// along the surface, a bias that builds up along a corridor.
-std::optional<Vec2> project_onto_neighbour_segments(const Scan2D& reference, std::size_t j,
-                                                    const Vec2& p, double max_length) {
+/// The nearest point to `p` on the segments from reference point j to its beam-order neighbours,
+/// and the unit normal of that segment (zero when j has no usable segment: the point is then j
+/// itself). Segments longer than `max_length` span a gap, not a surface, and are not used.
+struct SegmentProjection {
+  Vec2 point, normal;
+};
+
+/// Empty when j ends a surface and `p` lies beyond that end: such a point has no counterpart in
+/// the reference (the edge of the range, an occlusion), and pairing it with the end would pull
+/// the scan back along the surface, a bias that builds up along a corridor.
+std::optional<SegmentProjection> project_onto_neighbour_segments(const Scan2D& reference,
+                                                                 std::size_t j, const Vec2& p,
+                                                                 double max_length) {
   const Vec2& q = reference.points[j];
-  Vec2 best = q;
+  SegmentProjection best{q, Vec2::Zero()};
   double best_squared = (p - q).squaredNorm();
   int segments = 0;
   bool beyond = false;
@@ -273,36 +303,13 @@ std::optional<Vec2> project_onto_neighbour_segments(const Scan2D& reference, std
     beyond = along < 0.0;
     const Vec2 candidate = q + std::clamp(along, 0.0, 1.0) * d;
     const double squared = (p - candidate).squaredNorm();
-    if (squared < best_squared) {
+    // The first usable segment always counts (its nearest point is never farther than j).
+    if (squared < best_squared || best.normal.isZero()) {
       best_squared = squared;
-      best = candidate;
+      best = {candidate, Vec2(-d.y(), d.x()) / std::sqrt(length_squared)};
     }
   }
   if (segments == 1 && beyond) return std::nullopt;
-  return best;
-}
-
-// Unit normal of the reference segment beside point j that `on_segment` lies on (zero when j has
-// no usable neighbour).
-Vec2 segment_normal(const Scan2D& reference, std::size_t j, const Vec2& on_segment,
-                    double max_length) {
-  const Vec2& q = reference.points[j];
-  Vec2 best = Vec2::Zero();
-  double best_distance = std::numeric_limits<double>::infinity();
-  for (const long step : {-1L, 1L}) {
-    const long k = beam_neighbour(reference, j, step);
-    if (k < 0) continue;
-    const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
-    const double length = d.norm();
-    if (length < 1e-9 || length > max_length) continue;
-    const Vec2 n(-d.y() / length, d.x() / length);
-    const double distance =
-        std::abs(n.dot(on_segment - q)) + ((on_segment - q).dot(d) < 0 ? 1.0 : 0.0);
-    if (distance < best_distance) {
-      best_distance = distance;
-      best = n;
-    }
-  }
   return best;
 }
 
@@ -316,7 +323,7 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
                                       o.coarse_translation, o.histogram_min_segment) *
                   initial;
   Pairs pairs;
-  Points2 line_points, normals;
+  std::vector<LinePair> line_pairs;
   const bool point_to_line = o.sparse_step == "point-to-line";
   std::optional<NearestNeighbours2D> tree;
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
@@ -325,70 +332,44 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
         trace_path(moved, reference.points, reference.circular, o.max_correspondence_distance,
                    &tree, o.path_max_step, o.path_keep_nearest_shared);
     pairs.clear();
-    if (point_to_line) {
-      line_points.clear();
-      normals.clear();
-    }
+    line_pairs.clear();
     for (std::size_t i = 0; i < moved.size(); ++i) {
       if (!path.valid[i]) continue;
       const std::size_t j = static_cast<std::size_t>(path.row[i]);
       if (point_to_line) {
-        const std::optional<Vec2> projected =
+        const auto projected =
             project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
-        if (!projected) continue;
-        const Vec2 q = *projected;
-        const Vec2 normal = segment_normal(reference, j, q, o.max_correspondence_distance);
-        if (normal.isZero()) continue;
-        pairs.from.push_back(current.points[i]);
-        pairs.to.push_back(q);
-        line_points.push_back(reference.points[j]);
-        normals.push_back(normal);
-        pairs.distance_sum += std::abs(normal.dot(moved[i] - reference.points[j]));
+        if (!projected || projected->normal.isZero()) continue;
+        const Vec2& n = projected->normal;
+        line_pairs.push_back({current.points[i], reference.points[j], n,
+                              std::abs(n.dot(moved[i] - reference.points[j]))});
         continue;
       }
       Vec2 q = reference.points[j];
       if (o.subsample_projection) {
-        const std::optional<Vec2> projected =
+        const auto projected =
             project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
         if (!projected) continue;
-        q = *projected;
+        q = projected->point;
       }
       pairs.from.push_back(current.points[i]);
       pairs.to.push_back(q);
       pairs.distance_sum += (moved[i] - q).norm();
     }
-    if (point_to_line && o.sparse_keep_fraction < 1.0 && pairs.from.size() > 3) {
-      // Drop the worst residuals beyond keep_fraction, as PL-ICP does.
-      std::vector<double> residual(pairs.from.size());
-      for (std::size_t k = 0; k < residual.size(); ++k)
-        residual[k] = std::abs(normals[k].dot(r.transform * pairs.from[k] - line_points[k]));
-      std::vector<double> sorted = residual;
-      const std::size_t keep = std::max<std::size_t>(
-          3, static_cast<std::size_t>(o.sparse_keep_fraction * static_cast<double>(sorted.size())));
-      std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(keep - 1),
-                       sorted.end());
-      const double limit = sorted[keep - 1];
-      std::size_t w = 0;
-      for (std::size_t k = 0; k < residual.size(); ++k) {
-        if (residual[k] > limit) continue;
-        pairs.from[w] = pairs.from[k];
-        pairs.to[w] = pairs.to[k];
-        line_points[w] = line_points[k];
-        normals[w] = normals[k];
-        ++w;
-      }
-      pairs.from.resize(w);
-      pairs.to.resize(w);
-      line_points.resize(w);
-      normals.resize(w);
+    Pose2 next;
+    if (point_to_line) {
+      if (line_pairs.size() < 3) break;
+      if (o.sparse_keep_fraction < 1.0) keep_nearest_fraction(line_pairs, o.sparse_keep_fraction);
+      r.pairs = line_pairs.size();
+      next = solve_line_pairs(line_pairs, r.error);
+    } else {
+      r.pairs = pairs.from.size();
+      if (r.pairs < 3) break;
+      next = align_svd(pairs.from, pairs.to);
+      r.error = pairs.distance_sum / static_cast<double>(r.pairs);
     }
-    r.pairs = pairs.from.size();
-    if (r.pairs < 3) break;
-    const Pose2 next = point_to_line ? solve_point_to_line(pairs.from, line_points, normals)
-                                     : align_svd(pairs.from, pairs.to);
     const Pose2 step = next * r.transform.inverse();
     r.transform = next;
-    r.error = pairs.distance_sum / static_cast<double>(r.pairs);
     if (small_step(step, std::max(o.tolerance, o.sparse_tolerance))) {
       r.converged = true;
       break;
@@ -415,6 +396,10 @@ Pose2 pose2(double x, double y, double theta) {
   T.linear() = Eigen::Rotation2Dd(theta).toRotationMatrix();
   T.translation() = Vec2(x, y);
   return T;
+}
+
+Pose2 pose2(const Eigen::Vector3d& xytheta) {
+  return pose2(xytheta.x(), xytheta.y(), xytheta.z());
 }
 
 double pose2_angle(const Pose2& T) {
@@ -447,6 +432,14 @@ const std::vector<std::string>& registration_2d_method_names() {
   static const std::vector<std::string> names = {"sparse-icp", "icp", "icp-kdtree", "pl-icp",
                                                  "normal-icp"};
   return names;
+}
+
+void check_registration_2d_method(const std::string& method) {
+  const auto& names = registration_2d_method_names();
+  if (std::find(names.begin(), names.end(), method) != names.end()) return;
+  std::string valid;
+  for (const std::string& name : names) valid += (valid.empty() ? "" : ", ") + name;
+  throw Error("unknown 2D registration method '" + method + "' (" + valid + ")");
 }
 
 Pose2 align_svd(const Points2& from, const Points2& to) {
@@ -513,11 +506,7 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
     return best;
   };
   // Rows outside the scan do not exist for an open scan; a circular scan wraps.
-  const auto neighbour = [&](long j, long step) -> long {
-    const long k = j + step;
-    if (circular) return (k + m) % m;
-    return k < 0 || k >= m ? -1 : k;
-  };
+  const auto neighbour = [&](long j, long step) { return beam_neighbour(m, circular, j, step); };
   const auto row_step = [&](long from, long to) {
     long d = to - from;
     if (circular) {
@@ -596,18 +585,15 @@ Pose2 solve_point_to_line(const Points2& points, const Points2& line_points,
                           const Points2& normals) {
   if (points.size() < 3 || line_points.size() != points.size() || normals.size() != points.size())
     throw Error("point-to-line step: needs three or more pairs with a normal each");
-  // Unknowns x = (tx, ty, c, s): residual n . (M_i x - q_i), M_i = [1 0 px -py; 0 1 py px].
   Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
   Eigen::Vector4d g = Eigen::Vector4d::Zero();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Vec2& p = points[i];
-    const Vec2& nrm = normals[i];
-    Eigen::Matrix<double, 2, 4> M;
-    M << 1, 0, p.x(), -p.y(), 0, 1, p.y(), p.x();
-    const Eigen::Matrix<double, 1, 4> a = nrm.transpose() * M;
-    H += a.transpose() * a;
-    g += a.transpose() * nrm.dot(line_points[i]);
-  }
+  for (std::size_t i = 0; i < points.size(); ++i)
+    add_line_pair(points[i], line_points[i], normals[i], H, g);
+  return solve_line_normal_equations(H, g);
+}
+
+namespace {
+Pose2 solve_line_normal_equations(const Eigen::Matrix4d& H, const Eigen::Vector4d& g) {
   // Eliminate t: for fixed v = (c, s), t = A^-1 (g_t - B v); the cost in v is v'Sv - 2h'v + k.
   const Eigen::Matrix2d A = H.topLeftCorner<2, 2>(), B = H.topRightCorner<2, 2>(),
                         D = H.bottomRightCorner<2, 2>();
@@ -657,13 +643,11 @@ Pose2 solve_point_to_line(const Points2& points, const Points2& line_points,
   T.translation() = Ainv * (gt - B * best_v);
   return T;
 }
+}  // namespace
 
 Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
                                     const Registration2DOptions& o, const Pose2& initial) {
-  const auto& names = registration_2d_method_names();
-  if (std::find(names.begin(), names.end(), o.method) == names.end())
-    throw Error("unknown 2D registration method '" + o.method +
-                "' (sparse-icp, icp, icp-kdtree, pl-icp, normal-icp)");
+  check_registration_2d_method(o.method);
   if (!(o.max_correspondence_distance > 0.0))
     throw Error("2D registration: the correspondence distance must be positive");
   if (o.max_iterations < 1) throw Error("2D registration: at least one iteration is needed");

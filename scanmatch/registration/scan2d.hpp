@@ -23,7 +23,8 @@ namespace scanmatch {
 
 using Pose2 = Eigen::Isometry2d;
 Pose2 pose2(double x, double y, double theta);
-double pose2_angle(const Pose2& T);  ///< theta in (-pi, pi]
+Pose2 pose2(const Eigen::Vector3d& xytheta);  ///< from (x, y, theta), as CARMEN logs store poses
+double pose2_angle(const Pose2& T);           ///< theta in (-pi, pi]
 
 struct Scan2D {
   std::vector<Eigen::Vector2d> points;  ///< valid returns, in beam order, laser frame, m
@@ -107,6 +108,8 @@ Registration2DResult register_scans(const Scan2D& current, const Scan2D& referen
                                     const Pose2& initial = Pose2::Identity());
 
 const std::vector<std::string>& registration_2d_method_names();
+/// Throws Error naming the valid methods unless `method` is one of them.
+void check_registration_2d_method(const std::string& method);
 
 // The steps of sparse-icp, exposed for tests and reuse.
 
