@@ -46,10 +46,12 @@ std::vector<ScanPair> simulated_pairs(std::size_t count, double max_translation,
   return pairs;
 }
 
-// Method names of the tables: the 2D methods, and "sparse-icp-paper", sparse-icp with every
-// setting as the paper has it (centroid translation, consecutive-point histogram, plain sample
-// pairs, SVD step).
+// Method names of the tables: the 2D methods, "sparse-icp-paper", sparse-icp with every setting
+// as the paper has it (centroid translation, consecutive-point histogram, plain sample pairs, SVD
+// step, one-to-one pairs), and "pl-icp-fitted", Censi's PL-ICP with sparse-icp's fitted lines
+// (not a baseline: it shows what the lines alone bring).
 constexpr const char* kPaperVariant = "sparse-icp-paper";
+constexpr const char* kFittedPlIcp = "pl-icp-fitted";
 
 Registration2DOptions options_for(const std::string& name) {
   Registration2DOptions o;
@@ -60,6 +62,11 @@ Registration2DOptions options_for(const std::string& name) {
     o.histogram_min_segment = 0.0;
     o.subsample_projection = false;
     o.sparse_step = "svd";
+    o.path_rules = PathRules{};
+    o.sparse_keep_fraction = 1.0;
+  } else if (name == kFittedPlIcp) {
+    o.method = "pl-icp";
+    o.pl_line_radius = o.sparse_line_radius;
   }
   return o;
 }
@@ -196,7 +203,8 @@ void add_bench2d_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option(
       "--method", o->methods,
-      "Methods (default: all, and sparse-icp-paper: sparse-icp with the paper's settings)");
+      "Methods (default: all, sparse-icp-paper: sparse-icp with the paper's settings, and "
+      "pl-icp-fitted: pl-icp with sparse-icp's fitted lines)");
   cmd->add_option("--log", o->logs, "CARMEN logs to map scan to scan (.log or .log.gz)");
   cmd->add_option("--search-window", o->search_window,
                   "Add variants with the correlative search over +- this many m (0: none)")
@@ -207,9 +215,10 @@ void add_bench2d_command(CLI::App& app) {
     if (o->methods.empty()) {
       o->methods = registration_2d_method_names();
       o->methods.insert(o->methods.begin() + 1, kPaperVariant);
+      o->methods.push_back(kFittedPlIcp);
     }
     for (const auto& m : o->methods)
-      if (m != kPaperVariant) check_registration_2d_method(m);
+      if (m != kPaperVariant && m != kFittedPlIcp) check_registration_2d_method(m);
     std::string md;
     if (o->pairs > 0) {
       md +=

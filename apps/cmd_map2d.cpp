@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <map>
 
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
@@ -67,12 +68,18 @@ void add_map2d_command(CLI::App& app) {
   cmd->add_option("--sparse-step", r.sparse_step,
                   "sparse-icp's step on the kept pairs: svd (the paper) or point-to-line")
       ->capture_default_str();
-  cmd->add_option("--path-max-step", r.path_max_step,
+  cmd->add_option("--path-max-step", r.path_rules.max_step,
                   "sparse-icp: reference rows a kept pair may skip (1: the paper)")
       ->capture_default_str();
-  cmd->add_flag("--keep-nearest-shared", r.path_keep_nearest_shared,
-                "sparse-icp: of the points sharing a reference point the nearest keeps it (the "
-                "paper drops them all)");
+  cmd->add_option("--shared-rows", r.path_rules.shared,
+                  "sparse-icp: points sharing a reference point: drop (the paper), keep-nearest "
+                  "or keep-all")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, PathRules::Shared>{
+              {"drop", PathRules::Shared::drop},
+              {"keep-nearest", PathRules::Shared::keep_nearest},
+              {"keep-all", PathRules::Shared::keep_all}},
+          CLI::ignore_case));
   cmd->add_flag("--centroid-translation", r.coarse_translation,
                 "sparse-icp: the paper's centroid translation in the coarse stage");
   cmd->add_option("--resolution", c->run.grid.resolution, "Grid cell size, m")

@@ -56,10 +56,17 @@ class NearestNeighbours2D {
   Tree2 tree_;
 };
 
+/// The beams of a scan sorted by bearing from the sensor: where the path is lost, the reference
+/// point nearest in bearing is where the reference scan would have seen a current point.
+struct BearingIndex {
+  explicit BearingIndex(const Points2& points);
+  long nearest(const Vec2& p) const;  ///< index of the point nearest in bearing to p
+  std::vector<std::pair<double, long>> sorted;
+};
+
 CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
-                              double max_distance,
-                              std::optional<NearestNeighbours2D>* reference_tree, long max_step = 1,
-                              bool keep_nearest_shared = false);
+                              double max_distance, std::optional<BearingIndex>& bearings,
+                              const PathRules& rules);
 
 std::pair<std::size_t, double> brute_force_nearest(const Points2& points, const Vec2& q) {
   std::size_t best = 0;
@@ -121,6 +128,72 @@ Points2 scan_normals(const Points2& points, bool circular, double max_gap) {
   return normals;
 }
 
+/// A line fitted to a reference point and its beam-order neighbours: a point on it (their
+/// centroid) and its unit normal, zero where too few neighbours lie on one straight surface.
+/// `inward` points from the reference point along its surface where the point ends the surface
+/// (no neighbour within the gap on one side), and is zero inside a surface.
+struct FittedLine {
+  Vec2 point = Vec2::Zero(), normal = Vec2::Zero(), inward = Vec2::Zero();
+};
+
+/// For each point, the least-squares line through the beam-order neighbours within `radius` of
+/// it, walking outwards until a gap longer than `max_gap`. Two neighbouring samples 3 cm apart
+/// with 1 % range noise give a line direction that is mostly noise; a fit over 20 cm averages it.
+/// Points whose neighbourhood bends (a corner: the smaller spread above a quarter of the larger)
+/// get no line.
+std::vector<FittedLine> fit_scan_lines(const Scan2D& scan, double radius, double max_gap) {
+  const long m = static_cast<long>(scan.points.size());
+  std::vector<FittedLine> lines(scan.points.size());
+  const double radius_squared = radius * radius, gap_squared = max_gap * max_gap;
+  for (long j = 0; j < m; ++j) {
+    const Vec2& centre = scan.points[static_cast<std::size_t>(j)];
+    // Sums relative to the centre point keep the covariance well conditioned.
+    Vec2 sum = Vec2::Zero();
+    double xx = 0, xy = 0, yy = 0;
+    int count = 1;
+    long first_neighbour[2] = {-1, -1};
+    for (int side = 0; side < 2; ++side) {
+      long previous = j;
+      for (long walked = 1; walked < m; ++walked) {
+        const long k = beam_neighbour(m, scan.circular, previous, side == 0 ? -1 : 1);
+        if (k < 0 || k == j) break;
+        const Vec2& q = scan.points[static_cast<std::size_t>(k)];
+        if ((q - scan.points[static_cast<std::size_t>(previous)]).squaredNorm() > gap_squared ||
+            (q - centre).squaredNorm() > radius_squared)
+          break;
+        if (walked == 1) first_neighbour[side] = k;
+        const Vec2 d = q - centre;
+        sum += d;
+        xx += d.x() * d.x();
+        xy += d.x() * d.y();
+        yy += d.y() * d.y();
+        ++count;
+        previous = k;
+      }
+    }
+    if (count < 3) continue;
+    const Vec2 mean = sum / count;
+    const double a = xx / count - mean.x() * mean.x(), b = xy / count - mean.x() * mean.y(),
+                 c = yy / count - mean.y() * mean.y();
+    // Eigenvalues of [a b; b c] in closed form; the normal is the minor axis.
+    const double half_difference = 0.5 * (a - c), root = std::hypot(half_difference, b);
+    const double major = 0.5 * (a + c) + root, minor = 0.5 * (a + c) - root;
+    if (minor > 0.0625 * major) continue;
+    Vec2 axis = a >= c ? Vec2(major - c, b) : Vec2(b, major - a);
+    if (axis.squaredNorm() < 1e-30) continue;
+    axis.normalize();
+    FittedLine& line = lines[static_cast<std::size_t>(j)];
+    line.point = centre + mean;
+    line.normal = Vec2(-axis.y(), axis.x());
+    const bool open[2] = {first_neighbour[0] < 0, first_neighbour[1] < 0};
+    if (open[0] != open[1]) {
+      const long inside = first_neighbour[open[0] ? 1 : 0];
+      line.inward = (scan.points[static_cast<std::size_t>(inside)] - centre).normalized();
+    }
+  }
+  return lines;
+}
+
 /// A point of the current scan against a line of the reference: the point (current frame), a
 /// point of the line and its unit normal (reference frame), and the distance at the current pose.
 struct LinePair {
@@ -151,8 +224,12 @@ void add_line_pair(const Vec2& p, const Vec2& on_line, const Vec2& normal, Eigen
 
 Pose2 solve_line_normal_equations(const Eigen::Matrix4d& H, const Eigen::Vector4d& g);
 
-/// Censi's closed-form step on the pairs; their mean distance goes to `mean_distance`.
-Pose2 solve_line_pairs(const std::vector<LinePair>& pairs, double& mean_distance) {
+/// Censi's closed-form step on the pairs; their mean distance goes to `mean_distance`. A faint
+/// pull towards the current pose (1e-6 of the pairs' weight) keeps a degenerate set solvable (a
+/// corridor's walls are all parallel): along what the pairs leave free the pose stays where it
+/// is, and elsewhere the pull changes nothing measurable.
+Pose2 solve_line_pairs(const std::vector<LinePair>& pairs, const Pose2& current,
+                       double& mean_distance) {
   Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
   Eigen::Vector4d g = Eigen::Vector4d::Zero();
   double sum = 0.0;
@@ -161,6 +238,11 @@ Pose2 solve_line_pairs(const std::vector<LinePair>& pairs, double& mean_distance
     sum += pair.distance;
   }
   mean_distance = sum / static_cast<double>(pairs.size());
+  const double pull = 1e-6 * static_cast<double>(pairs.size());
+  const Eigen::Vector4d x(current.translation().x(), current.translation().y(),
+                          current.linear()(0, 0), current.linear()(1, 0));
+  H.diagonal().array() += pull;
+  g += pull * x;
   return solve_line_normal_equations(H, g);
 }
 
@@ -230,6 +312,9 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
                                        const Registration2DOptions& o, const Pose2& initial) {
   const NearestNeighbours2D tree(reference.points);
   const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
+  std::vector<FittedLine> lines;
+  if (o.pl_line_radius > 0.0)
+    lines = fit_scan_lines(reference, o.pl_line_radius, o.max_correspondence_distance);
   std::vector<LinePair> pairs;
   Registration2DResult r;
   r.transform = initial;
@@ -239,6 +324,12 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
       const Vec2 p = r.transform * point;
       const auto [j, squared] = tree.nearest(p);
       if (squared > max_squared) continue;
+      if (!lines.empty() && !lines[j].normal.isZero()) {
+        const FittedLine& line = lines[j];
+        pairs.push_back(
+            {point, line.point, line.normal, std::abs(line.normal.dot(p - line.point))});
+        continue;
+      }
       // The second point: the nearer beam-order neighbour of j, if it is close enough to be on
       // the same surface.
       double best = std::numeric_limits<double>::infinity();
@@ -262,7 +353,7 @@ Registration2DResult point_to_line_icp(const Scan2D& current, const Scan2D& refe
     if (pairs.size() < 3) break;
     keep_nearest_fraction(pairs, o.keep_fraction);
     r.pairs = pairs.size();
-    const Pose2 next = solve_line_pairs(pairs, r.error);
+    const Pose2 next = solve_line_pairs(pairs, r.transform, r.error);
     const Pose2 step = next * r.transform.inverse();
     r.transform = next;
     if (small_step(step, o.tolerance)) {
@@ -325,18 +416,35 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
   Pairs pairs;
   std::vector<LinePair> line_pairs;
   const bool point_to_line = o.sparse_step == "point-to-line";
-  std::optional<NearestNeighbours2D> tree;
+  std::optional<BearingIndex> bearings;
+  std::vector<FittedLine> lines;
+  if (point_to_line && o.sparse_line_radius > 0.0)
+    lines = fit_scan_lines(reference, o.sparse_line_radius, o.max_correspondence_distance);
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
     const Points2 moved = transformed(current.points, r.transform);
     const CorrespondencePath path =
         trace_path(moved, reference.points, reference.circular, o.max_correspondence_distance,
-                   &tree, o.path_max_step, o.path_keep_nearest_shared);
+                   bearings, o.path_rules);
     pairs.clear();
     line_pairs.clear();
     for (std::size_t i = 0; i < moved.size(); ++i) {
       if (!path.valid[i]) continue;
       const std::size_t j = static_cast<std::size_t>(path.row[i]);
       if (point_to_line) {
+        if (!lines.empty() && !lines[j].normal.isZero()) {
+          const FittedLine& line = lines[j];
+          // Beyond the end of the surface (see project_onto_neighbour_segments), or beyond the
+          // stretch the line was fitted to (a run of current points on one reference point can
+          // reach far along it): no pair.
+          const Vec2 offset = moved[i] - line.point;
+          if ((moved[i] - reference.points[j]).dot(line.inward) < 0.0 ||
+              std::abs(offset.x() * line.normal.y() - offset.y() * line.normal.x()) >
+                  o.sparse_line_radius)
+            continue;
+          line_pairs.push_back({current.points[i], line.point, line.normal,
+                                std::abs(line.normal.dot(moved[i] - line.point))});
+          continue;
+        }
         const auto projected =
             project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
         if (!projected || projected->normal.isZero()) continue;
@@ -361,7 +469,7 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
       if (line_pairs.size() < 3) break;
       if (o.sparse_keep_fraction < 1.0) keep_nearest_fraction(line_pairs, o.sparse_keep_fraction);
       r.pairs = line_pairs.size();
-      next = solve_line_pairs(line_pairs, r.error);
+      next = solve_line_pairs(line_pairs, r.transform, r.error);
     } else {
       r.pairs = pairs.from.size();
       if (r.pairs < 3) break;
@@ -474,17 +582,31 @@ Pose2 coarse_alignment_2d(const Points2& current, const Points2& reference, doub
 }
 
 CorrespondencePath correspondence_path(const Points2& current, const Points2& reference,
-                                       bool circular, double max_distance, long max_step,
-                                       bool keep_nearest_shared) {
-  return trace_path(current, reference, circular, max_distance, nullptr, max_step,
-                    keep_nearest_shared);
+                                       bool circular, double max_distance, const PathRules& rules) {
+  std::optional<BearingIndex> bearings;
+  return trace_path(current, reference, circular, max_distance, bearings, rules);
 }
 
 namespace {
+BearingIndex::BearingIndex(const Points2& points) {
+  sorted.reserve(points.size());
+  for (std::size_t j = 0; j < points.size(); ++j)
+    sorted.emplace_back(std::atan2(points[j].y(), points[j].x()), static_cast<long>(j));
+  std::sort(sorted.begin(), sorted.end());
+}
+
+long BearingIndex::nearest(const Vec2& p) const {
+  const double bearing = std::atan2(p.y(), p.x());
+  auto after = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(bearing, -1L));
+  if (after == sorted.end()) after = sorted.begin();  // wraps past +pi
+  const auto before = after == sorted.begin() ? sorted.end() - 1 : after - 1;
+  const auto gap = [&](double b) { return std::abs(std::remainder(b - bearing, 2 * M_PI)); };
+  return gap(before->first) < gap(after->first) ? before->second : after->second;
+}
+
 CorrespondencePath trace_path(const Points2& current, const Points2& reference, bool circular,
-                              double max_distance,
-                              std::optional<NearestNeighbours2D>* reference_tree, long max_step,
-                              bool keep_nearest_shared) {
+                              double max_distance, std::optional<BearingIndex>& bearings,
+                              const PathRules& rules) {
   const long n = static_cast<long>(current.size()), m = static_cast<long>(reference.size());
   CorrespondencePath path;
   path.row.assign(static_cast<std::size_t>(n), 0);
@@ -493,17 +615,6 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
   const auto distance = [&](long i, long j) {
     const Vec2 d = current[static_cast<std::size_t>(i)] - reference[static_cast<std::size_t>(j)];
     return std::abs(d.x()) + std::abs(d.y());
-  };
-  const auto column_minimum = [&](long i) {
-    if (reference_tree) {  // the Euclidean nearest: the Manhattan minimum or next to it
-      if (!reference_tree->has_value()) reference_tree->emplace(reference);  // built when needed
-      return static_cast<long>(
-          (*reference_tree)->nearest(current[static_cast<std::size_t>(i)]).first);
-    }
-    long best = 0;
-    for (long j = 1; j < m; ++j)
-      if (distance(i, j) < distance(i, best)) best = j;
-    return best;
   };
   // Rows outside the scan do not exist for an open scan; a circular scan wraps.
   const auto neighbour = [&](long j, long step) { return beam_neighbour(m, circular, j, step); };
@@ -515,36 +626,46 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
     }
     return d;
   };
+  // The 3x1 window slides from row j towards decreasing distance until its centre is the minimum.
+  const auto slide = [&](long i, long& j, double& d) {
+    for (long moves = 0; moves < m; ++moves) {
+      long best = j;
+      double best_d = d;
+      for (const long step : {-1L, 1L}) {
+        const long k = neighbour(j, step);
+        if (k < 0) continue;
+        const double dk = distance(i, k);
+        if (dk < best_d) {
+          best = k;
+          best_d = dk;
+        }
+      }
+      if (best == j) return;
+      j = best;
+      d = best_d;
+    }
+  };
 
   std::vector<double> best_distance(static_cast<std::size_t>(n));
-  long j = column_minimum(0);
+  long j = 0;  // the path starts at the minimum of the first column
+  for (long k = 1; k < m; ++k)
+    if (distance(0, k) < distance(0, j)) j = k;
   for (long i = 0; i < n; ++i) {
     double d = distance(i, j);
     if (i > 0) {
-      // The 3x1 window slides from the previous row towards decreasing distance.
-      for (long moves = 0; moves < m; ++moves) {
-        long best = j;
-        double best_d = d;
-        for (const long step : {-1L, 1L}) {
-          const long k = neighbour(j, step);
-          if (k < 0) continue;
-          const double dk = distance(i, k);
-          if (dk < best_d) {
-            best = k;
-            best_d = dk;
-          }
+      slide(i, j, d);
+      if (d > max_distance) {
+        // Lost (an occlusion or a gap): pick the path up again at the reference beam nearest in
+        // bearing, where the reference would have seen this point, and slide from there.
+        if (!bearings) bearings.emplace(reference);  // built once, when first needed
+        const long seed = bearings->nearest(current[static_cast<std::size_t>(i)]);
+        double seed_d = distance(i, seed);
+        long seed_j = seed;
+        slide(i, seed_j, seed_d);
+        if (seed_d < d) {
+          j = seed_j;
+          d = seed_d;
         }
-        if (best == j) break;
-        j = best;
-        d = best_d;
-      }
-      if (d > max_distance) {  // lost: pick the path up again, then settle
-        j = column_minimum(i);
-        for (const long step : {-1L, 1L}) {
-          const long k = neighbour(j, step);
-          if (k >= 0 && distance(i, k) < distance(i, j)) j = k;
-        }
-        d = distance(i, j);
       }
     }
     path.row[static_cast<std::size_t>(i)] = static_cast<int>(j);
@@ -552,10 +673,11 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
   }
   // Invalid pairs: abnormal steps (repeat = many-to-one, skip = one-to-many, backwards, jumps),
   // shared reference points and distances above the threshold. What is left is one-to-one.
-  // Relaxed (not the paper): a skip of up to `max_step` rows is normal, and of the columns that
-  // share a row the nearest keeps it.
+  // Relaxed (not the paper): a skip of up to `max_step` rows is normal; of the columns that share
+  // a row the nearest keeps it, or all do (a run on one row is then one normal step).
   const auto at = [&](long k) { return static_cast<long>(path.row[static_cast<std::size_t>(k)]); };
   const auto dist = [&](long k) { return best_distance[static_cast<std::size_t>(k)]; };
+  const long max_step = rules.max_step;
   for (long i = 0; i < n; ++i) {
     const auto normal_step = [&](long from, long to) {
       const long d = row_step(at(from), at(to));
@@ -563,17 +685,21 @@ CorrespondencePath trace_path(const Points2& current, const Points2& reference, 
     };
     bool normal = i > 0 ? normal_step(i - 1, i) : (i + 1 < n && normal_step(i, i + 1));
     bool shared = (i > 0 && at(i - 1) == at(i)) || (i + 1 < n && at(i + 1) == at(i));
-    if (keep_nearest_shared && shared) {
-      // The run of columns on this row; the nearest one keeps the pair.
+    if (shared && rules.shared != PathRules::Shared::drop) {
+      // The run of columns on this row, judged by the steps into and out of it.
       long first = i, last = i;
       while (first > 0 && at(first - 1) == at(i)) --first;
       while (last + 1 < n && at(last + 1) == at(i)) ++last;
-      long nearest = first;
-      for (long k = first + 1; k <= last; ++k)
-        if (dist(k) < dist(nearest)) nearest = k;
-      shared = nearest != i;
-      normal = (first == 0 || normal_step(first - 1, first)) ||
+      normal = (first > 0 && normal_step(first - 1, first)) ||
                (last + 1 < n && normal_step(last, last + 1));
+      if (rules.shared == PathRules::Shared::keep_all && last - first < rules.max_run) {
+        shared = false;
+      } else {
+        long nearest = first;
+        for (long k = first + 1; k <= last; ++k)
+          if (dist(k) < dist(nearest)) nearest = k;
+        shared = nearest != i;
+      }
     }
     path.valid[static_cast<std::size_t>(i)] = normal && !shared && dist(i) <= max_distance;
   }
