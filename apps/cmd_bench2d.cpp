@@ -64,6 +64,7 @@ Registration2DOptions options_for(const std::string& name) {
     o.sparse_step = "svd";
     o.path_rules = PathRules{};
     o.sparse_keep_fraction = 1.0;
+    o.sparse_min_pairs = 0.0;
   } else if (name == kFittedPlIcp) {
     o.method = "pl-icp";
     o.pl_line_radius = o.sparse_line_radius;

@@ -31,13 +31,25 @@ struct LikelihoodGrid {
   }
 };
 
-LikelihoodGrid make_grid(const std::vector<Vec2>& reference, const Vec2& low, const Vec2& high,
-                         double resolution) {
+/// The grid spans the reference points only: a current point landing elsewhere scores nothing.
+/// Below them it reaches one block further, so that block_max bounds the blocks that start
+/// outside (`g.at` is zero off the grid). Coarser cells where the area is huge, so memory stays
+/// bounded.
+LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) {
   LikelihoodGrid g;
-  // Coarser cells where the area is huge (a long corridor log), so memory stays bounded.
+  Vec2 low = reference.front(), high = reference.front();
+  for (const Vec2& p : reference) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  const auto cells = [&](double r) {
+    const Vec2 size = high - low;
+    return (size.x() / r + kBlock + 6) * (size.y() / r + kBlock + 6);
+  };
+  while (cells(resolution) > static_cast<double>(kMaxCells)) resolution *= 2;
+  low -= Vec2::Constant((kBlock + 3) * resolution);
+  high += Vec2::Constant(3 * resolution);
   const Vec2 size = high - low;
-  while ((size.x() / resolution + 1) * (size.y() / resolution + 1) > static_cast<double>(kMaxCells))
-    resolution *= 2;
   g.resolution = resolution;
   g.origin = low;
   g.width = static_cast<int>(std::ceil(size.x() / resolution)) + 1;
@@ -123,7 +135,7 @@ Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const P
   for (const Vec2& q : reference.points)
     if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
   if (useful.empty()) return initial;
-  const LikelihoodGrid g = make_grid(useful, low, high, resolution);
+  const LikelihoodGrid g = make_grid(useful, resolution);
   const double r = g.resolution;
 
   // Angular step: the farthest point moves by about one cell.

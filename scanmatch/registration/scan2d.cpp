@@ -464,15 +464,20 @@ Registration2DResult sparse_icp(const Scan2D& current, const Scan2D& reference,
       pairs.to.push_back(q);
       pairs.distance_sum += (moved[i] - q).norm();
     }
+    // Too few pairs left: the path no longer follows a surface both scans saw, and steps taken
+    // on what is left wander off (up to 170 deg on FHW from a poor start). Stop where we are.
+    const std::size_t kept = point_to_line ? line_pairs.size() : pairs.from.size();
+    if (static_cast<double>(kept) < std::max(3.0, o.sparse_min_pairs * moved.size())) {
+      r.pairs = kept;
+      break;
+    }
     Pose2 next;
     if (point_to_line) {
-      if (line_pairs.size() < 3) break;
       if (o.sparse_keep_fraction < 1.0) keep_nearest_fraction(line_pairs, o.sparse_keep_fraction);
       r.pairs = line_pairs.size();
       next = solve_line_pairs(line_pairs, r.transform, r.error);
     } else {
       r.pairs = pairs.from.size();
-      if (r.pairs < 3) break;
       next = align_svd(pairs.from, pairs.to);
       r.error = pairs.distance_sum / static_cast<double>(r.pairs);
     }

@@ -94,6 +94,11 @@ struct Registration2DOptions {
   /// sparse-icp with the point-to-line step: the worst residuals beyond this fraction of the kept
   /// pairs are dropped each iteration (1: none, the paper).
   double sparse_keep_fraction = 0.95;
+  /// sparse-icp stops (not converged) when fewer than this fraction of the current points keep
+  /// a pair: the path has lost the surfaces the scans share, and further steps only wander.
+  /// Meant for the relaxed path rules; the paper's one-to-one rules keep too few pairs from a
+  /// poor start for it (0: off, the paper).
+  double sparse_min_pairs = 0.1;
   /// sparse-icp with the point-to-line step: each kept pair's line is fitted to the reference
   /// points within this radius of its reference point (beam-order neighbours on one straight
   /// surface), m; where there is no such line (a corner, sparse returns), the segment to the
