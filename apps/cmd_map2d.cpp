@@ -80,6 +80,10 @@ void add_map2d_command(CLI::App& app) {
               {"keep-nearest", PathRules::Shared::keep_nearest},
               {"keep-all", PathRules::Shared::keep_all}},
           CLI::ignore_case));
+  cmd->add_option("--line-radius", r.sparse_line_radius,
+                  "sparse-icp: lines are fitted to the reference within this radius, m (0: the "
+                  "segment to the next beam)")
+      ->capture_default_str();
   cmd->add_flag("--centroid-translation", r.coarse_translation,
                 "sparse-icp: the paper's centroid translation in the coarse stage");
   cmd->add_option("--resolution", c->run.grid.resolution, "Grid cell size, m")
