@@ -3,8 +3,11 @@
 // baselines of its Table 1. Scans are points in the laser frame, in beam order; poses are
 // Eigen::Isometry2d (x, y, theta).
 //
-//   sparse-icp   angle-histogram rotation, centroid translation, the Manhattan-distance
-//                correspondence path with invalid pairs dropped, SVD ICP on what is left
+//   sparse-icp   angle-histogram rotation, (optionally) centroid translation, the
+//                Manhattan-distance correspondence path with invalid pairs dropped, then the
+//                closed-form point-to-line step against lines fitted to the reference (the
+//                paper's SVD step on sample pairs is an option); docs/planar.md says where and
+//                why the defaults differ from the paper
 //   icp          point-to-point, brute-force nearest neighbours, SVD step
 //   icp-kdtree   the same with a k-d tree
 //   pl-icp       Censi's point-to-line ICP with its exact closed-form step (Lagrange multiplier)
