@@ -24,6 +24,7 @@ struct Map2DCommand {
   std::size_t scans = 0;
   std::uint64_t seed = 1;
   bool no_motion_distortion = false;
+  double rotation_period = -1.0;  ///< s; negative: the input's own
   double search_angle_deg = 45.0, keyframe_angle_deg = 0.0;
   Map2DRunOptions run;
 };
@@ -47,9 +48,13 @@ void add_map2d_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--scans", c->scans, "Process at most this many scans (0: all)");
   cmd->add_option("--seed", c->seed, "Seed of sim: sequences")->capture_default_str();
-  cmd->add_flag(
-      "--no-motion-distortion", c->no_motion_distortion,
-      "sim: sequences: measure each scan from its start pose (2D scans are not deskewed)");
+  cmd->add_flag("--no-motion-distortion", c->no_motion_distortion,
+                "sim: sequences: measure each scan from its start pose");
+  cmd->add_option("--rotation-period", c->rotation_period,
+                  "s per turn of the laser, for deskewing (default: the simulated sensor's; "
+                  "unknown for logs, so they are not deskewed)");
+  cmd->add_flag("--deskew", c->run.mapper.deskew,
+                "Deskew scans by the last step's motion (experimental: see docs/planar.md)");
   cmd->add_option("--max-distance", r.max_correspondence_distance,
                   "Correspondence distance threshold D, m")
       ->capture_default_str();
@@ -100,7 +105,8 @@ void add_map2d_command(CLI::App& app) {
     c->run.mapper.constant_velocity = c->initial == "constant-velocity";
     c->run.mapper.registration.search_angle = c->search_angle_deg * M_PI / 180;
     c->run.mapper.keyframe_angle = c->keyframe_angle_deg * M_PI / 180;
-    const Scans2D input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
+    Scans2D input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
+    if (c->rotation_period >= 0.0) input.rotation_period = c->rotation_period;
     interrupted.store(false);
     c->run.stop = &interrupted;
     const auto previous = std::signal(SIGINT, on_map2d_interrupt);

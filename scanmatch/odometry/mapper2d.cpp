@@ -11,20 +11,53 @@ Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
   check_registration_2d_method(config.registration.method);
 }
 
-Pose2 Mapper2D::add_scan(const Scan2D& scan) {
+namespace {
+
+/// Each point moved to where it would have been seen from the pose at the first beam, the sensor
+/// moving by `motion` every `interval` seconds. Misses carry no times and stay as measured.
+Scan2D deskewed(const Scan2D& scan, const Pose2& motion, double interval) {
+  Scan2D out = scan;
+  const double dx = motion.translation().x(), dy = motion.translation().y(),
+               dtheta = pose2_angle(motion);
+  for (std::size_t i = 0; i < out.points.size(); ++i) {
+    const double s = scan.times[i] / interval;
+    out.points[i] = pose2(s * dx, s * dy, s * dtheta) * scan.points[i];
+  }
+  return out;
+}
+
+}  // namespace
+
+Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   stats_ = {};
-  stats_.points = scan.points.size();
+  stats_.points = input.points.size();
   ++scans_;
+  const double interval = timestamp - last_timestamp_;
+  last_timestamp_ = timestamp;
+  const bool timed = config_.deskew && input.times.size() == input.points.size();
   if (scans_ == 1) {
-    keyframe_ = scan;
+    keyframe_ = last_scan_ = input;
     return pose_;
   }
   const Pose2 predicted = pose_ * (config_.constant_velocity ? motion_ : Pose2::Identity());
   const Pose2 guess = keyframe_pose_.inverse() * predicted;  // current in the keyframe's frame
+  // Both scans are deskewed by one velocity, the last step's motion. Deskewing each scan by the
+  // step before it (the keyframe by an older one) made the next registration see the difference
+  // of two velocity errors and over-correct it: the poses oscillated and diverged on room-2d. A
+  // second pass with this step's own motion changed nothing measurable.
+  const bool deskew = timed && keyframe_.times.size() == keyframe_.points.size() &&
+                      motion_interval_ > 0.0 && interval > 0.0;
+  Scan2D current_deskewed, keyframe_deskewed;
+  if (deskew) {
+    current_deskewed = deskewed(input, motion_, motion_interval_);
+    keyframe_deskewed = deskewed(keyframe_, motion_, motion_interval_);
+  }
+  const Scan2D& current = deskew ? current_deskewed : input;
+  const Scan2D& reference = deskew ? keyframe_deskewed : keyframe_;
   Pose2 relative = guess;
   const auto start = std::chrono::steady_clock::now();
   try {
-    const Registration2DResult r = register_scans(scan, keyframe_, config_.registration, guess);
+    const Registration2DResult r = register_scans(current, reference, config_.registration, guess);
     const Pose2 correction = guess.inverse() * r.transform;
     if (r.pairs >= 3 && r.transform.matrix().allFinite() &&
         correction.translation().norm() <= config_.max_correction &&
@@ -45,16 +78,20 @@ Pose2 Mapper2D::add_scan(const Scan2D& scan) {
   // Re-orthonormalise: chaining thousands of products slowly bends R off SO(2).
   pose = pose2(pose.translation().x(), pose.translation().y(), pose2_angle(pose));
   motion_ = pose_.inverse() * pose;
+  motion_interval_ = interval;
   pose_ = pose;
+  // For the map: deskewed by the motion into it (the best estimate of its own until the next).
+  last_scan_ = timed && interval > 0.0 ? deskewed(input, motion_, interval) : input;
   const bool scan_to_scan = config_.keyframe_distance <= 0.0 && config_.keyframe_angle <= 0.0;
   const bool far =
       scan_to_scan ||
       (config_.keyframe_distance > 0.0 &&
        relative.translation().norm() >= config_.keyframe_distance) ||
       (config_.keyframe_angle > 0.0 && std::abs(pose2_angle(relative)) >= config_.keyframe_angle);
-  // A bridged scan becomes the reference only when the old one is no better.
-  if (far && (!stats_.bridged || scan.points.size() >= keyframe_.points.size())) {
-    keyframe_ = scan;
+  // A bridged scan becomes the reference only when the old one is no better. Kept as measured:
+  // it is deskewed anew with each step's velocity.
+  if (far && (!stats_.bridged || input.points.size() >= keyframe_.points.size())) {
+    keyframe_ = input;
     keyframe_pose_ = pose_;
   }
   return pose_;

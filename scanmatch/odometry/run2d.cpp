@@ -48,6 +48,7 @@ Scans2D load_scans_2d(const std::string& spec, std::size_t max_scans, std::uint6
       throw Error(spec + ": not a 2D preset (the 2D preset is room-2d)");
     for (std::size_t i = 0; i < simulator.size(); ++i) out.scans.push_back(simulator.scan_2d(i));
     out.has_reference = true;
+    if (motion_distortion) out.rotation_period = simulator.sensor().frame_period();
     out.description = fmt::format("{} (simulated, seed {})", spec, seed);
     return out;
   }
@@ -96,9 +97,10 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     const LaserScan2D& laser = input.scans[i];
     const double miss_range =
         options.miss_range > 0.0 ? std::min<double>(options.miss_range, laser.max_range) : 0.0;
-    Scan2D scan = scan_from_laser(laser, options.mapper.min_range, miss_range);
+    Scan2D scan =
+        scan_from_laser(laser, options.mapper.min_range, miss_range, input.rotation_period);
     if (options.miss_range <= 0.0) scan.misses.clear();
-    const Pose2 pose = mapper.add_scan(scan);
+    const Pose2 pose = mapper.add_scan(scan, laser.timestamp);
     const Scan2DStats& s = mapper.last_stats();
     estimate.push_back(pose);
     reference.push_back(pose2(laser.pose));
@@ -111,7 +113,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     const auto insert = [&](OccupancyGrid& g, std::string& error, const Pose2& at) {
       if (!error.empty()) return;
       try {
-        g.insert_scan(at, scan.points, scan.misses);
+        g.insert_scan(at, mapper.last_scan().points, scan.misses);
       } catch (const Error& e) {
         error = e.what();
       }
@@ -174,6 +176,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       {"pl_line_radius", r.pl_line_radius},
       {"search_window", r.search_window},
       {"search_angle_deg", r.search_angle * 180 / M_PI},
+      {"deskew", options.mapper.deskew && input.rotation_period > 0.0},
+      {"rotation_period_s", input.rotation_period},
       {"grid_resolution", options.grid.resolution},
       {"miss_range", options.miss_range}};
   j["scans"] = summary.scans;

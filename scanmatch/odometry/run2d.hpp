@@ -15,6 +15,9 @@ namespace scanmatch {
 struct Scans2D {
   std::vector<LaserScan2D> scans;
   bool has_reference = false;  ///< the scans' poses are a reference (log-corrected or simulated)
+  /// s per turn of the laser (0: unknown, no deskewing): known for `sim:`, set by the user for
+  /// logs (CARMEN logs do not record it).
+  double rotation_period = 0.0;
   std::string description;
 };
 

@@ -519,7 +519,8 @@ double pose2_angle(const Pose2& T) {
   return std::atan2(T.linear()(1, 0), T.linear()(0, 0));
 }
 
-Scan2D scan_from_laser(const LaserScan2D& scan, double min_range, double miss_range) {
+Scan2D scan_from_laser(const LaserScan2D& scan, double min_range, double miss_range,
+                       double rotation_period) {
   Scan2D out;
   const double max_range = scan.max_range;
   const double free_range = miss_range > 0.0 ? miss_range : max_range;
@@ -535,6 +536,9 @@ Scan2D scan_from_laser(const LaserScan2D& scan, double min_range, double miss_ra
     }
     if (range <= min_range) continue;
     out.points.push_back(range * direction);
+    if (rotation_period > 0.0)
+      out.times.push_back(rotation_period * static_cast<double>(i) *
+                          std::abs(scan.angle_increment) / (2 * M_PI));
   }
   const double span = static_cast<double>(scan.ranges.size()) * std::abs(scan.angle_increment);
   out.circular = span > 2 * M_PI - 1.5 * std::abs(scan.angle_increment);

@@ -34,12 +34,18 @@ struct Scan2D {
   /// End points of no-return beams at the maximum range (free space for grid maps), laser frame.
   std::vector<Eigen::Vector2d> misses;
   bool circular = false;  ///< a 360-degree scan: the last beam neighbours the first
+  /// Per point, when its beam was measured, s after the first beam (empty: not known). A
+  /// spinning laser sweeps while it moves; Mapper2D deskews with these.
+  std::vector<double> times;
 };
 
 /// Valid beams (finite, range in (min_range, max_range)) as points, in beam order; `circular`
 /// when the beams cover the full circle. Beams at or beyond the maximum range become `misses`
-/// at `miss_range` (0: the scan's max range).
-Scan2D scan_from_laser(const LaserScan2D& scan, double min_range = 0.05, double miss_range = 0.0);
+/// at `miss_range` (0: the scan's max range). With `rotation_period` (s per turn of the laser's
+/// mirror or head; 0: unknown) each point gets its time: beams are measured in order, one full
+/// turn taking the period.
+Scan2D scan_from_laser(const LaserScan2D& scan, double min_range = 0.05, double miss_range = 0.0,
+                       double rotation_period = 0.0);
 
 /// sparse-icp's invalid-pair rules. The paper keeps a pair only after the normal step (the next
 /// reference index, `max_step` 1) and drops every pair whose reference point is shared with a
