@@ -11,6 +11,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/trajectory.hpp"
@@ -113,6 +115,12 @@ TEST(OdometryCli, BadInputFailsWithAClearMessage) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("000002.pcd"), std::string::npos) << r.output;
   EXPECT_EQ(count_lines(dir.file("cut/poses.txt")), 2u);
+  // ... and its summary says so.
+  std::ifstream summary_file(dir.file("cut/summary.json"));
+  ASSERT_TRUE(summary_file.good());
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["frames"], 2);
+  EXPECT_NE(summary["error"].get<std::string>().find("000002.pcd"), std::string::npos);
 }
 
 TEST(OdometryCli, CtrlCKeepsWhatWasDoneAndExits130) {

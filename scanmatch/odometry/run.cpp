@@ -144,7 +144,12 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       summary.interrupted = true;
       break;
     }
-    if (!source.next(frame)) break;
+    try {
+      if (!source.next(frame)) break;
+    } catch (const Error& e) {
+      summary.error = e.what();  // the run ends here, keeping what it finished
+      break;
+    }
     const Pose pose = odometry.register_frame(frame.cloud, frame.timestamp);
     const FrameStats& s = odometry.last_stats();
     pipeline_ms += s.total_ms;
@@ -197,6 +202,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
         {"frames", summary.frames},
         {"bridged_frames", summary.bridged_frames},
         {"interrupted", summary.interrupted},
+        {"error", summary.error},
         {"frames_per_second", summary.frames_per_second},
         {"threads", config.threads},
         {"stages",
@@ -208,6 +214,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
         {"options", nlohmann::ordered_json::parse(odometry_config_to_json(config))}};
     write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");
   }
+  if (!summary.error.empty()) throw Error(summary.error);
   return summary;
 }
 

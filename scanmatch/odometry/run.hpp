@@ -6,7 +6,8 @@
 //                   points_in,points_downsampled,iterations,condition_number,
 //                   degenerate_directions,bridged
 //   summary.json    method, options (the whole configuration), frames, mean and max ms per stage,
-//                   frames per second, whether the run was interrupted (written atomically at end)
+//                   frames per second, whether the run was interrupted, the error that ended it
+//                   early (written atomically at the end, also after such an error)
 //   config.json     the OdometryConfig used (reloadable with --config)
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
 // Per-frame files are appended and flushed frame by frame, so an interrupted run keeps its frames.
@@ -44,6 +45,7 @@ struct RunSummary {
   std::string source;  ///< SequenceSource::describe()
   std::size_t frames = 0, bridged_frames = 0;
   bool interrupted = false;
+  std::string error;  ///< why the source could not deliver a frame (empty: it did not fail)
   StageStatistics preprocess, coarse, fine, map_update, total;
   double frames_per_second = 0.0;  ///< 1000 / mean total ms (pipeline time only)
   std::vector<double> timestamps;  ///< per frame
@@ -53,7 +55,8 @@ struct RunSummary {
 
 /// Runs `config` over `source` (from its current position) and writes RUNDIR as described above.
 /// Bad frames (empty, unreadable) are reported on stderr and bridged, never fatal; a frame the
-/// source cannot deliver at all (Error from next()) ends the run with that error.
+/// source cannot deliver at all (Error from next(), e.g. a truncated file) ends the run: RUNDIR
+/// is finished for the frames before it (summary.json with "error"), then that Error is thrown.
 RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                         const RunOptions& options);
 
