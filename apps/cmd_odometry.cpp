@@ -41,6 +41,8 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
     if (given("--method")) config.method = c.config.method;
     if (given("--voxel")) config.voxel_size = c.config.voxel_size;
     if (given("--ndt-resolution")) config.ndt_resolution = c.config.ndt_resolution;
+    if (given("--voxel-resolution"))
+      config.registration.voxel_resolution = c.config.registration.voxel_resolution;
     if (given("--map-voxel")) config.map_voxel_size = c.config.map_voxel_size;
     if (given("--merge-threshold")) config.merge_threshold = c.config.merge_threshold;
     if (given("--map-radius")) config.map_radius = c.config.map_radius;
@@ -133,7 +135,10 @@ void add_odometry_command(CLI::App& app) {
   cmd->add_option("--threads", o.threads, "Threads (1 for fair comparisons)")
       ->capture_default_str();
   cmd->add_option("--voxel", o.voxel_size, "Downsampling voxel, m")->capture_default_str();
-  cmd->add_option("--ndt-resolution", o.ndt_resolution, "Coarse NDT grid, m")
+  cmd->add_option("--ndt-resolution", o.ndt_resolution, "ctf-icp: the coarse stage's NDT grid, m")
+      ->capture_default_str();
+  cmd->add_option("--voxel-resolution", o.registration.voxel_resolution,
+                  "The ndt and vgicp methods: their Gaussian voxel grid, m")
       ->capture_default_str();
   cmd->add_option("--map-voxel", o.map_voxel_size, "Global Gaussian map voxel, m")
       ->capture_default_str();
