@@ -90,6 +90,15 @@ TEST(OdometryCli, ConfigurationRoundTripsAndRejectsUnknownKeys) {
   const OdometryConfig used = read_odometry_config(dir.file("run/config.json"));
   EXPECT_EQ(used.method, "ndt");
   EXPECT_DOUBLE_EQ(used.voxel_size, 0.4);
+  // Options on the command line win over the file, each reaching its own setting.
+  const auto r2 =
+      run_cli("odometry sim:static-indoor --frames 3 --quiet --out " + dir.file("run2") +
+              " --config " + dir.file("c.json") + " --voxel-resolution 0.7 --ndt-resolution 1.5");
+  ASSERT_EQ(r2.status, 0) << r2.output;
+  const OdometryConfig used2 = read_odometry_config(dir.file("run2/config.json"));
+  EXPECT_DOUBLE_EQ(used2.registration.voxel_resolution, 0.7);
+  EXPECT_DOUBLE_EQ(used2.ndt_resolution, 1.5);
+  EXPECT_DOUBLE_EQ(used2.voxel_size, 0.4);
 }
 
 TEST(OdometryCli, BadInputFailsWithAClearMessage) {
