@@ -283,9 +283,18 @@ void run_bench(BenchOptions o) {
     result.data_folder = folder;
     for (const auto& v : vs) {
       Cell cell;
-      std::string dir_name = v.name;
-      for (char& ch : dir_name)
-        if (ch == ' ') ch = '_';
+      // "ctf-icp --no-fine" -> "ctf-icp_no-fine": words joined by '_', option dashes dropped.
+      std::string dir_name;
+      bool word_start = true;
+      for (const char ch : v.name) {
+        if (ch == ' ') {
+          if (!dir_name.empty() && dir_name.back() != '_') dir_name += '_';
+          word_start = true;
+        } else if (!(word_start && ch == '-')) {
+          dir_name += ch;
+          word_start = false;
+        }
+      }
       cell.folder = o.out + "/runs/" + name + "/" + dir_name;
       try {
         auto source = open_sequence_folder(folder);

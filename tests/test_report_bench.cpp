@@ -99,7 +99,7 @@ TEST(Bench, OneRunGivesEveryTableForEveryMethod) {
   EXPECT_NE(read_text(dir.file("b/tables.csv")).find("static-indoor"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir.file("b/report.html")));
   EXPECT_TRUE(
-      std::filesystem::exists(dir.file("b/runs/dynamic-outdoor-fast/ctf-icp_--no-fine/poses.txt")));
+      std::filesystem::exists(dir.file("b/runs/dynamic-outdoor-fast/ctf-icp_no-fine/poses.txt")));
   const auto bad = run_cli("bench --method magic --out " + dir.file("c"));
   EXPECT_NE(bad.status, 0);
   EXPECT_NE(bad.output.find("magic"), std::string::npos);
