@@ -5,7 +5,6 @@
 
 #include <atomic>
 #include <csignal>
-#include <map>
 
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
@@ -24,6 +23,7 @@ struct Map2DCommand {
   std::size_t scans = 0;
   std::uint64_t seed = 1;
   bool no_motion_distortion = false;
+  std::string shared_rows = to_string(Registration2DOptions{}.path_rules.shared);
   double rotation_period = -1.0;  ///< s; negative: the input's own
   double search_angle_deg = 45.0, keyframe_angle_deg = 0.0;
   Map2DRunOptions run;
@@ -76,15 +76,10 @@ void add_map2d_command(CLI::App& app) {
   cmd->add_option("--path-max-step", r.path_rules.max_step,
                   "sparse-icp: reference rows a kept pair may skip (1: the paper)")
       ->capture_default_str();
-  cmd->add_option("--shared-rows", r.path_rules.shared,
+  cmd->add_option("--shared-rows", c->shared_rows,
                   "sparse-icp: points sharing a reference point: drop (the paper), keep-nearest "
                   "or keep-all")
-      ->transform(CLI::CheckedTransformer(
-          std::map<std::string, PathRules::Shared>{
-              {"drop", PathRules::Shared::drop},
-              {"keep-nearest", PathRules::Shared::keep_nearest},
-              {"keep-all", PathRules::Shared::keep_all}},
-          CLI::ignore_case));
+      ->capture_default_str();
   cmd->add_option("--line-radius", r.sparse_line_radius,
                   "sparse-icp: lines are fitted to the reference within this radius, m (0: the "
                   "segment to the next beam)")
@@ -105,6 +100,7 @@ void add_map2d_command(CLI::App& app) {
     c->run.mapper.constant_velocity = c->initial == "constant-velocity";
     c->run.mapper.registration.search_angle = c->search_angle_deg * M_PI / 180;
     c->run.mapper.keyframe_angle = c->keyframe_angle_deg * M_PI / 180;
+    c->run.mapper.registration.path_rules.shared = parse_shared_rows(c->shared_rows);
     Scans2D input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
     if (c->rotation_period >= 0.0) input.rotation_period = c->rotation_period;
     interrupted.store(false);

@@ -309,6 +309,22 @@ TEST(Scan2D, BadInputGivesClearErrors) {
   EXPECT_THROW(register_scans(nan, room, o), Error);
   o.method = "no-such-method";
   EXPECT_THROW(register_scans(room, room, o), Error);
+  // Options out of range are refused, not silently clamped.
+  const auto refused = [&](auto change) {
+    Registration2DOptions bad;
+    change(bad);
+    EXPECT_THROW(register_scans(room, room, bad), Error);
+  };
+  refused([](Registration2DOptions& b) { b.path_rules.max_step = 0; });
+  refused([](Registration2DOptions& b) { b.path_rules.max_run = 0; });
+  refused([](Registration2DOptions& b) { b.sparse_line_radius = -0.1; });
+  refused([](Registration2DOptions& b) { b.sparse_keep_fraction = 0.0; });
+  refused([](Registration2DOptions& b) { b.keep_fraction = 1.5; });
+  refused([](Registration2DOptions& b) { b.sparse_min_pairs = 1.0; });
+  for (const auto shared :
+       {PathRules::Shared::drop, PathRules::Shared::keep_nearest, PathRules::Shared::keep_all})
+    EXPECT_EQ(parse_shared_rows(to_string(shared)), shared);
+  EXPECT_THROW(parse_shared_rows("keep"), Error);
 }
 
 TEST(Metrics2D, RelativeErrorOfAKnownDrift) {
@@ -445,6 +461,10 @@ TEST(Map2D, CliWritesARunFolderAndRejectsBadInput) {
       scanmatch::testing::run_cli("map2d " + dir.file("none.log") + " --out " + dir.file("r3"));
   EXPECT_NE(missing.status, 0);
   EXPECT_NE(missing.output.find("none.log"), std::string::npos) << missing.output;
+  const auto rule =
+      scanmatch::testing::run_cli("map2d sim:room-2d --shared-rows some --out " + dir.file("r4"));
+  EXPECT_NE(rule.status, 0);
+  EXPECT_NE(rule.output.find("'some'"), std::string::npos) << rule.output;
 }
 
 TEST(Map2D, RegisterAcceptsTwoDimensionalScans) {

@@ -167,9 +167,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       {"sparse_step", r.sparse_step},
       {"sparse_line_radius", r.sparse_line_radius},
       {"path_max_step", r.path_rules.max_step},
-      {"path_shared_rows", r.path_rules.shared == PathRules::Shared::drop           ? "drop"
-                           : r.path_rules.shared == PathRules::Shared::keep_nearest ? "keep-nearest"
-                                                                                    : "keep-all"},
+      {"path_shared_rows", to_string(r.path_rules.shared)},
       {"path_max_run", r.path_rules.max_run},
       {"sparse_keep_fraction", r.sparse_keep_fraction},
       {"sparse_min_pairs", r.sparse_min_pairs},

@@ -138,7 +138,8 @@ struct FittedLine {
 
 /// For each point, the least-squares line through the beam-order neighbours within `radius` of
 /// it, walking outwards until a gap longer than `max_gap`. Two neighbouring samples 3 cm apart
-/// with 1 % range noise give a line direction that is mostly noise; a fit over 20 cm averages it.
+/// with 1 % range noise give a line direction that is mostly noise; a fit over +-30 cm averages
+/// it.
 /// Points whose neighbourhood bends (a corner: the smaller spread above a quarter of the larger)
 /// get no line.
 std::vector<FittedLine> fit_scan_lines(const Scan2D& scan, double radius, double max_gap) {
@@ -551,6 +552,25 @@ const std::vector<std::string>& registration_2d_method_names() {
   return names;
 }
 
+const char* to_string(PathRules::Shared shared) {
+  switch (shared) {
+    case PathRules::Shared::drop:
+      return "drop";
+    case PathRules::Shared::keep_nearest:
+      return "keep-nearest";
+    case PathRules::Shared::keep_all:
+      return "keep-all";
+  }
+  return "?";
+}
+
+PathRules::Shared parse_shared_rows(const std::string& name) {
+  for (const auto shared :
+       {PathRules::Shared::drop, PathRules::Shared::keep_nearest, PathRules::Shared::keep_all})
+    if (name == to_string(shared)) return shared;
+  throw Error("unknown shared-rows rule '" + name + "' (drop, keep-nearest, keep-all)");
+}
+
 void check_registration_2d_method(const std::string& method) {
   const auto& names = registration_2d_method_names();
   if (std::find(names.begin(), names.end(), method) != names.end()) return;
@@ -789,6 +809,15 @@ Registration2DResult register_scans(const Scan2D& current, const Scan2D& referen
   if (o.sparse_step != "svd" && o.sparse_step != "point-to-line")
     throw Error("2D registration: unknown sparse-icp step '" + o.sparse_step +
                 "' (svd, point-to-line)");
+  if (o.path_rules.max_step < 1 || o.path_rules.max_run < 1)
+    throw Error("2D registration: the path's max step and max run must be at least 1");
+  if (!(o.sparse_line_radius >= 0.0) || !(o.pl_line_radius >= 0.0))
+    throw Error("2D registration: a line radius must be 0 or positive");
+  if (!(o.sparse_keep_fraction > 0.0 && o.sparse_keep_fraction <= 1.0) ||
+      !(o.keep_fraction > 0.0 && o.keep_fraction <= 1.0))
+    throw Error("2D registration: a keep fraction must be in (0, 1]");
+  if (!(o.sparse_min_pairs >= 0.0 && o.sparse_min_pairs < 1.0))
+    throw Error("2D registration: sparse_min_pairs must be in [0, 1)");
   check_scan(current, "current");
   check_scan(reference, "reference");
   Pose2 start = initial;

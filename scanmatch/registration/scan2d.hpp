@@ -61,6 +61,10 @@ struct PathRules {
   /// occlusion): its line is no evidence for them.
   long max_run = 3;
 };
+/// "drop", "keep-nearest", "keep-all": the names the CLI and run summaries use.
+const char* to_string(PathRules::Shared shared);
+/// The inverse of to_string; throws Error naming the valid names.
+PathRules::Shared parse_shared_rows(const std::string& name);
 
 struct Registration2DOptions {
   std::string method = "sparse-icp";  ///< sparse-icp, icp, icp-kdtree, pl-icp, normal-icp
