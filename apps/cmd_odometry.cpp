@@ -119,15 +119,13 @@ void add_odometry_command(CLI::App& app) {
   auto c = std::make_shared<OdometryCommand>();
   auto* cmd = app.add_subcommand(
       "odometry", "LiDAR odometry over a sequence: poses, timing, summary and optionally a map");
-  std::string methods = "ctf-icp";
-  for (const auto& m : registration_method_names()) methods += ", " + m;
   OdometryConfig& o = c->config;
   cmd->add_option("SEQUENCE", c->sequence,
                   "A folder of PCD/PLY/BIN frames, a KITTI sequence, a simulated data set or "
                   "sim:PRESET")
       ->required();
   cmd->add_option("--out", c->out, "Run folder (created)")->required();
-  cmd->add_option("--method", o.method, "One of: " + methods)->capture_default_str();
+  cmd->add_option("--method", o.method, "One of: " + odometry_method_list())->capture_default_str();
   cmd->add_option("--config", c->config_file,
                   "JSON configuration (as written to RUNDIR/config.json); options given here win");
   cmd->add_option("--frames", c->frames, "Process at most this many frames (0: all)");

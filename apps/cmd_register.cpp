@@ -167,14 +167,13 @@ void run(RegisterCommand& c) {
 
 void add_register_command(CLI::App& app) {
   auto c = std::make_shared<RegisterCommand>();
-  std::string methods;
-  for (const auto& m : registration_method_names()) methods += (methods.empty() ? "" : ", ") + m;
   auto* cmd = app.add_subcommand(
       "register",
       "Register SOURCE onto TARGET; prints the 4x4 transform mapping SOURCE into TARGET");
   cmd->add_option("SOURCE", c->source, "Source cloud")->required();
   cmd->add_option("TARGET", c->target, "Target cloud")->required();
-  cmd->add_option("--method", c->options.method, "One of: " + methods)->capture_default_str();
+  cmd->add_option("--method", c->options.method, "One of: " + registration_method_list())
+      ->capture_default_str();
   cmd->add_option("--init", c->init,
                   "Initial guess: 16 numbers (row-major 4x4) or x,y,z,roll,pitch,yaw (m, deg)");
   cmd->add_option("--voxel", c->voxel, "Voxel downsampling of both clouds, m (0: none)")
@@ -203,6 +202,10 @@ void add_register_command(CLI::App& app) {
                 "sparse-icp (default), icp, icp-kdtree, pl-icp, normal-icp");
   cmd->add_option("--search-window", c->planar_options.search_window,
                   "2D: correlative coarse search over +- this many m first (0: off)");
+  std::string methods = "3D methods (what each builds first):\n";
+  for (const auto& m : registration_methods())
+    methods += fmt::format("  {:<15} {} ({})\n", m.name, m.summary, m.builds);
+  cmd->footer(methods);
   cmd->callback([c] { run(*c); });
 }
 

@@ -11,7 +11,7 @@
 #include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/cloud_io.hpp"
-#include "scanmatch/registration/factors.hpp"
+#include "scanmatch/registration/solver.hpp"
 #include "scanmatch/registration/methods.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"

@@ -7,8 +7,8 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
-#include "scanmatch/registration/ctf_fine.hpp"
-#include "scanmatch/registration/factors.hpp"
+#include "scanmatch/registration/factors/ctf_fine.hpp"
+#include "scanmatch/registration/factors/ndt.hpp"
 
 namespace scanmatch {
 namespace {
@@ -33,15 +33,18 @@ GaussianVoxelMapOptions ndt_options(const OdometryConfig& c) {
   return o;
 }
 
+}  // namespace
+
+std::string odometry_method_list() {
+  return "ctf-icp, " + registration_method_list();
+}
+
+namespace {
+
 void check_config(const OdometryConfig& c) {
-  if (c.method != "ctf-icp") {
-    const auto names = registration_method_names();
-    if (std::find(names.begin(), names.end(), c.method) == names.end()) {
-      std::string valid = "ctf-icp";
-      for (const auto& n : names) valid += ", " + n;
-      throw Error("unknown odometry method '" + c.method + "' (valid: " + valid + ")");
-    }
-  }
+  if (c.method != "ctf-icp" && !is_registration_method(c.method))
+    throw Error("unknown odometry method '" + c.method + "' (valid: " + odometry_method_list() +
+                ")");
   const auto positive = [](double v, const char* name) {
     if (!(v > 0.0) || !std::isfinite(v))
       throw Error(std::string("odometry: ") + name + " must be positive");

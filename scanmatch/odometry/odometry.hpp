@@ -79,6 +79,9 @@ struct FrameStats {
   bool bridged = false;           ///< the frame could not be registered: the motion prior was used
 };
 
+/// "ctf-icp, icp, ...": the odometry's methods (ctf-icp and every registration method).
+std::string odometry_method_list();
+
 class Odometry {
  public:
   /// Throws Error for an unknown method or invalid parameters.

@@ -1,48 +1,45 @@
 #pragma once
-// Registration methods by name: every method of the three papers and their baselines, each a
-// factor (factors.hpp) on the one solver (solver.hpp), plus ICP's classic closed-form SVD step.
+// The table of 3D registration methods: every method of the three papers and their baselines.
+// Each is a factor (registration/factors/, one per file) on the one solver (solver.hpp), plus
+// ICP's classic closed-form SVD step. Name lists, validation and CLI help all come from the
+// table; adding a method is a factor file and one table entry in methods.cpp.
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
-#include "scanmatch/features/loam_features.hpp"
+#include "scanmatch/registration/options.hpp"
 #include "scanmatch/registration/solver.hpp"
 
 namespace scanmatch {
 
-struct RegistrationOptions {
-  /// icp (SVD step, k-d tree), icp-kdtree (same), icp-brute (SVD step, exhaustive search),
-  /// icp-gn (point-to-point on the Gauss-Newton solver), point-to-plane, point-to-line, gicp,
-  /// vgicp, ndt, ctf-fine, loam (edge and planar features), loam-edge, loam-plane.
-  std::string method = "gicp";
-  double max_correspondence_distance = 1.0;  ///< m, point-based methods
-  int normal_neighbours = 10;                ///< k for normals (point-to-plane)
-  int covariance_neighbours = 20;            ///< k for covariances (gicp, vgicp)
-  double gicp_epsilon = 1e-3;                ///< smallest normalised eigenvalue of GICP covariances
-  double voxel_resolution = 1.0;    ///< m, the Gaussian voxel map of vgicp, ndt and ctf-fine
-  int voxel_neighbours = 0;         ///< 1, 7 or 27 voxels per point; 0: the method's default
-                                    ///< (ndt 7, vgicp 1, ctf-fine 1)
-  double ndt_outlier_ratio = 0.55;  ///< Magnusson's outlier probability for the score constants
-  double ctf_epsilon = 1e-6;        ///< CTF-ICP's normalised smallest eigenvalue
-  LoamFeatureOptions loam;          ///< feature extraction of the loam methods
-  SolverOptions solver;
+struct RegistrationMethod {
+  const char* name;
+  const char* summary;  ///< one line: the residual and the step
+  const char* builds;   ///< what it builds before iterating (trees, normals, covariances, maps)
+  /// Points each cloud needs (neighbourhoods, a determined system).
+  std::size_t (*minimum_points)(const RegistrationOptions& options);
+  RegistrationResult (*run)(const PointCloud& source, const PointCloud& target,
+                            const RegistrationOptions& options, const Pose& initial);
 };
 
+/// Every method, in the order the CLI lists them.
+const std::vector<RegistrationMethod>& registration_methods();
+/// The method called `name`; throws Error "unknown registration method 'x' (valid: ...)".
+const RegistrationMethod& find_registration_method(const std::string& name);
+bool is_registration_method(const std::string& name);
+std::vector<std::string> registration_method_names();
+/// "icp, icp-kdtree, ..." for help texts and errors.
+std::string registration_method_list();
+/// Points a cloud needs for the method; throws Error for an unknown method.
+std::size_t minimum_points(const std::string& method, const RegistrationOptions& options);
+
 /// Registers source onto target from `initial` (a guess of T_target_source). Throws Error for an
-/// unknown method or too few points.
+/// unknown method, too few points or a non-finite guess.
 RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target,
                                    const RegistrationOptions& options,
                                    const Pose& initial = Pose::Identity());
-
-std::vector<std::string> registration_method_names();
-
-/// Magnusson's NDT score constants d1, d2: the Gaussian fitted to a mixture of a normal and a
-/// uniform outlier distribution, for voxel size `resolution` (m) and outlier probability
-/// `outlier_ratio`.
-void ndt_score_constants(double resolution, double outlier_ratio, double& d1, double& d2);
-/// Points a cloud needs for the method (neighbourhoods, a determined system).
-std::size_t minimum_points(const std::string& method, const RegistrationOptions& options);
 
 /// Mean squared nearest-neighbour distance of the source points under T that have a target point
 /// within max_distance (PCL's fitness score), and how many had one.

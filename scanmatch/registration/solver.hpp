@@ -124,10 +124,11 @@ inline Eigen::Matrix<double, 3, 6> point_jacobian(const Pose& T, const Eigen::Ve
 
 struct SolverOptions {
   int max_iterations = 30;
-  double rotation_tolerance = 1e-5;       ///< rad: converged when the update is smaller ...
-  double translation_tolerance = 1e-5;    ///< m: ... in both rotation and translation,
-  double relative_cost_tolerance = 1e-9;  ///< or the cost changes relatively less than this
-  bool levenberg_marquardt = false;       ///< LM damping (accepts only cost-decreasing steps)
+  double rotation_tolerance = 1e-5;     ///< rad: converged when the update is smaller ...
+  double translation_tolerance = 1e-5;  ///< m: ... in both rotation and translation,
+  double relative_cost_tolerance =
+      1e-9;                          ///< or the cost changes relatively less than this (0: off)
+  bool levenberg_marquardt = false;  ///< LM damping (accepts only cost-decreasing steps)
   double initial_lambda = 1e-6;
   RobustKernel kernel;
   int num_threads = 1;  ///< 1: single-threaded reduction; > 1: TBB with that many threads
@@ -136,6 +137,11 @@ struct SolverOptions {
   /// initial guess. 0 turns it off. See analyse_degeneracy for the scaling.
   double degeneracy_ratio = 0.0;
   double degeneracy_range = 10.0;  ///< m: a rotation counts as the displacement at this range
+  /// Gauss-Newton only: after the last step (below tolerance, or the iteration limit) linearise
+  /// once more, so that the result's cost, inliers and information are those of the returned
+  /// pose. false saves that pass (one of ~5 in the odometry's fine stage); the result then
+  /// reports the linearisation before the last step.
+  bool final_linearization = true;
 };
 
 /// Which directions of an information matrix H (tangent order [rotation; translation]) are
@@ -211,6 +217,17 @@ RegistrationResult optimize(const Factor& factor, const Pose& initial,
       break;
     }
     const Pose candidate = orthonormalized(T * se3_exp(delta));
+    const bool small_step = delta.head<3>().norm() < options.rotation_tolerance &&
+                            delta.tail<3>().norm() < options.translation_tolerance;
+    if (!options.final_linearization && !options.levenberg_marquardt &&
+        (small_step || iteration + 1 == options.max_iterations)) {
+      T = candidate;
+      if (small_step) {
+        result.converged = true;
+        result.stop_reason = "update below tolerance";
+      }
+      break;
+    }
     LinearSystem next = linearize_all(factor, candidate, options);
     if (options.levenberg_marquardt && next.cost > system.cost && next.inliers >= system.inliers) {
       lambda *= 10.0;  // reject the step, damp more
@@ -224,14 +241,14 @@ RegistrationResult optimize(const Factor& factor, const Pose& initial,
     const double previous_cost = system.cost;
     T = candidate;
     system = std::move(next);
-    if (delta.head<3>().norm() < options.rotation_tolerance &&
-        delta.tail<3>().norm() < options.translation_tolerance) {
+    if (small_step) {
       result.converged = true;
       result.stop_reason = "update below tolerance";
       break;
     }
-    if (std::abs(previous_cost - system.cost) <=
-        options.relative_cost_tolerance * std::max(std::abs(previous_cost), 1e-30)) {
+    if (options.relative_cost_tolerance > 0.0 &&
+        std::abs(previous_cost - system.cost) <=
+            options.relative_cost_tolerance * std::max(std::abs(previous_cost), 1e-30)) {
       result.converged = true;
       result.stop_reason = "cost change below tolerance";
       break;
