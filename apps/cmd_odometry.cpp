@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "apps/commands.hpp"
+#include "apps/config_options.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/trajectory.hpp"
@@ -35,21 +36,9 @@ struct OdometryCommand {
 void run_command(OdometryCommand& c, const CLI::App& cmd) {
   // Options given on the command line win over the --config file.
   OdometryConfig config = c.config;
-  if (!c.config_file.empty()) {
-    config = read_odometry_config(c.config_file, OdometryConfig{});
-    const auto given = [&](const char* name) { return cmd.count(name) > 0; };
-    if (given("--method")) config.method = c.config.method;
-    if (given("--voxel")) config.voxel_size = c.config.voxel_size;
-    if (given("--ndt-resolution")) config.ndt_resolution = c.config.ndt_resolution;
-    if (given("--voxel-resolution"))
-      config.registration.voxel_resolution = c.config.registration.voxel_resolution;
-    if (given("--map-voxel")) config.map_voxel_size = c.config.map_voxel_size;
-    if (given("--merge-threshold")) config.merge_threshold = c.config.merge_threshold;
-    if (given("--map-radius")) config.map_radius = c.config.map_radius;
-    if (given("--max-iterations")) config.fine_max_iterations = c.config.fine_max_iterations;
-    if (given("--degeneracy-ratio")) config.degeneracy_ratio = c.config.degeneracy_ratio;
-    if (given("--threads")) config.threads = c.config.threads;
-  }
+  if (!c.config_file.empty())
+    config = override_given_flags(read_odometry_config(c.config_file), c.config,
+                                  [&](const std::string& flag) { return cmd.count(flag) > 0; });
   if (c.no_fine) config.fine_stage = false;
   if (c.no_map_update) config.map_update = false;
   if (c.no_deskew) config.deskew = false;
@@ -125,31 +114,12 @@ void add_odometry_command(CLI::App& app) {
                   "sim:PRESET")
       ->required();
   cmd->add_option("--out", c->out, "Run folder (created)")->required();
-  cmd->add_option("--method", o.method, "One of: " + odometry_method_list())->capture_default_str();
   cmd->add_option("--config", c->config_file,
                   "JSON configuration (as written to RUNDIR/config.json); options given here win");
   cmd->add_option("--frames", c->frames, "Process at most this many frames (0: all)");
   cmd->add_option("--seed", c->seed, "Seed of sim:PRESET sequences")->capture_default_str();
-  cmd->add_option("--threads", o.threads, "Threads (1 for fair comparisons)")
-      ->capture_default_str();
-  cmd->add_option("--voxel", o.voxel_size, "Downsampling voxel, m")->capture_default_str();
-  cmd->add_option("--ndt-resolution", o.ndt_resolution, "ctf-icp: the coarse stage's NDT grid, m")
-      ->capture_default_str();
-  cmd->add_option("--voxel-resolution", o.registration.voxel_resolution,
-                  "The ndt and vgicp methods: their Gaussian voxel grid, m")
-      ->capture_default_str();
-  cmd->add_option("--map-voxel", o.map_voxel_size, "Global Gaussian map voxel, m")
-      ->capture_default_str();
-  cmd->add_option("--merge-threshold", o.merge_threshold,
-                  "New points a map voxel collects before it is merged")
-      ->capture_default_str();
-  cmd->add_option("--map-radius", o.map_radius, "Map voxels farther than this are dropped, m")
-      ->capture_default_str();
-  cmd->add_option("--max-iterations", o.fine_max_iterations, "Fine stage Gauss-Newton steps")
-      ->capture_default_str();
-  cmd->add_option("--degeneracy-ratio", o.degeneracy_ratio,
-                  "Eigenvalue ratio below which a direction keeps the prior (0: off)")
-      ->capture_default_str();
+  add_config_options(cmd, o);
+  cmd->get_option("--method")->description("One of: " + odometry_method_list());
   cmd->add_flag("--no-fine", c->no_fine, "Ablation: coarse NDT stage only");
   cmd->add_flag("--no-map-update", c->no_map_update,
                 "Ablation: fine stage against the previous frame, no global map");

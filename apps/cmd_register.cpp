@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "apps/commands.hpp"
+#include "apps/config_options.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/cloud_io.hpp"
@@ -17,7 +18,7 @@ namespace scanmatch::cli {
 namespace {
 
 struct RegisterCommand {
-  std::string source, target, init, kernel = "none";
+  std::string source, target, init;
   bool planar = false;
   Registration2DOptions planar_options;
   double voxel = 0.1;
@@ -125,7 +126,6 @@ void run(RegisterCommand& c) {
     source = voxel_downsample(source, c.voxel);
     target = voxel_downsample(target, c.voxel);
   }
-  c.options.solver.kernel.type = parse_kernel(c.kernel);
   const auto start = std::chrono::steady_clock::now();
   const RegistrationResult r = register_clouds(source, target, c.options, initial);
   const double ms =
@@ -180,22 +180,7 @@ void add_register_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--threads", c->options.solver.num_threads, "Threads for linearisation")
       ->capture_default_str();
-  cmd->add_option("--max-iterations", c->options.solver.max_iterations, "Iteration limit")
-      ->capture_default_str();
-  cmd->add_option("--max-distance", c->options.max_correspondence_distance,
-                  "Correspondence distance, m")
-      ->capture_default_str();
-  cmd->add_option("--resolution", c->options.voxel_resolution,
-                  "Gaussian voxel size for vgicp, ndt, ctf-fine, m")
-      ->capture_default_str();
-  cmd->add_option("--neighbours", c->options.voxel_neighbours,
-                  "Voxels per point: 1, 7 or 27 (0: method default)");
-  cmd->add_option("--kernel", c->kernel, "Robust kernel: none, huber, cauchy, tukey, geman-mcclure")
-      ->capture_default_str();
-  cmd->add_option("--kernel-scale", c->options.solver.kernel.scale, "Robust kernel scale, m")
-      ->capture_default_str();
-  cmd->add_flag("--lm", c->options.solver.levenberg_marquardt,
-                "Levenberg-Marquardt instead of Gauss-Newton");
+  add_config_options(cmd, c->options);
   cmd->add_flag("--json", c->json, "Print JSON");
   cmd->add_flag("--2d", c->planar,
                 "2D laser scans: SOURCE and TARGET are CARMEN logs, LOG or LOG:INDEX; methods "

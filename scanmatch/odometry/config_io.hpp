@@ -1,10 +1,11 @@
 #pragma once
-// OdometryConfig as JSON: every run writes the configuration it used (RUNDIR/config.json) and
-// `--config FILE` loads one back, so any number can be reproduced. Keys are the field names of
-// OdometryConfig, with "registration" (RegistrationOptions), "registration.solver"
-// (SolverOptions) and "registration.loam" nested. A file may give any subset; unknown keys and
-// wrong types are errors naming the file and the key.
+// OdometryConfig as JSON, from the one description in config_fields.hpp: every run writes the
+// configuration it used (RUNDIR/config.json) and `--config FILE` loads one back, so any number can
+// be reproduced. Keys are the field names, with "registration", "registration.solver" and
+// "registration.loam" nested. A file may give any subset; unknown keys and wrong types are errors
+// naming the file and the key.
 
+#include <functional>
 #include <string>
 
 #include "scanmatch/odometry/odometry.hpp"
@@ -18,5 +19,9 @@ OdometryConfig odometry_config_from_json(const std::string& json_text, const std
                                          const OdometryConfig& base = {});
 /// Reads a JSON configuration file on top of `base`.
 OdometryConfig read_odometry_config(const std::string& path, const OdometryConfig& base = {});
+/// `base` with the fields whose command-line flag `was_given` taken from `given`: a --config
+/// file overridden by exactly the options on the command line.
+OdometryConfig override_given_flags(const OdometryConfig& base, const OdometryConfig& given,
+                                    const std::function<bool(const std::string& flag)>& was_given);
 
 }  // namespace scanmatch

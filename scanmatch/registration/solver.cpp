@@ -22,6 +22,22 @@ KernelType parse_kernel(const std::string& name) {
               "' (valid: none, huber, cauchy, tukey, geman-mcclure)");
 }
 
+const char* kernel_name(KernelType type) {
+  switch (type) {
+    case KernelType::kNone:
+      return "none";
+    case KernelType::kHuber:
+      return "huber";
+    case KernelType::kCauchy:
+      return "cauchy";
+    case KernelType::kTukey:
+      return "tukey";
+    case KernelType::kGemanMcClure:
+      return "geman-mcclure";
+  }
+  return "none";
+}
+
 LinearSystem reduce_parallel(
     std::size_t n, int num_threads,
     const std::function<void(std::size_t, std::size_t, LinearSystem&)>& block) {

@@ -24,6 +24,8 @@ namespace scanmatch {
 enum class KernelType { kNone, kHuber, kCauchy, kTukey, kGemanMcClure };
 /// "none", "huber", "cauchy", "tukey", "geman-mcclure"; throws Error.
 KernelType parse_kernel(const std::string& name);
+/// The inverse of parse_kernel.
+const char* kernel_name(KernelType type);
 
 /// Robust kernel on the squared (Mahalanobis) residual s = r^T W r, as an IRLS weight.
 struct RobustKernel {

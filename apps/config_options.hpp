@@ -1,0 +1,40 @@
+#pragma once
+// Command-line options from the configuration's one description (odometry/config_fields.hpp):
+// every described field with a flag becomes an option bound to that field.
+
+#include <CLI/CLI.hpp>
+#include <type_traits>
+
+#include "scanmatch/odometry/config_fields.hpp"
+
+namespace scanmatch::cli {
+
+struct ConfigOptionAdder {
+  CLI::App* cmd;
+  template <typename T>
+  void operator()(const char*, T& field, const char* flag, const char* help) {
+    if (!flag) return;
+    if constexpr (std::is_same_v<T, bool>) {
+      cmd->add_flag(flag, field, help);
+    } else if constexpr (std::is_same_v<T, KernelType>) {
+      cmd->add_option_function<std::string>(
+             flag, [&field](const std::string& name) { field = parse_kernel(name); }, help)
+          ->default_str(kernel_name(field));
+    } else {
+      cmd->add_option(flag, field, help)->capture_default_str();
+    }
+  }
+  template <typename S>
+  void nested(const char*, S& options) {
+    describe(options, *this);
+  }
+};
+
+/// Adds an option for every described field of `options` that has a flag.
+template <typename Options>
+void add_config_options(CLI::App* cmd, Options& options) {
+  ConfigOptionAdder adder{cmd};
+  describe(options, adder);
+}
+
+}  // namespace scanmatch::cli

@@ -1,0 +1,94 @@
+// The one configuration description: JSON keys, flags and the --config override derive from it.
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/odometry/config_fields.hpp"
+#include "scanmatch/odometry/config_io.hpp"
+
+namespace scanmatch {
+namespace {
+
+struct FlagCollector {
+  std::vector<std::string> flags;
+  template <typename T>
+  void operator()(const char*, T&, const char* flag, const char*) {
+    if (flag) flags.emplace_back(flag);
+  }
+  template <typename S>
+  void nested(const char*, S& options) {
+    describe(options, *this);
+  }
+};
+
+TEST(ConfigDescription, FlagsAreUniqueAndSpelledLikeOptions) {
+  OdometryConfig config;
+  FlagCollector collector;
+  describe(config, collector);
+  std::set<std::string> seen;
+  for (const auto& flag : collector.flags) {
+    EXPECT_TRUE(seen.insert(flag).second) << flag << " is described twice";
+    EXPECT_EQ(flag.rfind("--", 0), 0u) << flag;
+  }
+  EXPECT_TRUE(seen.count("--max-iterations"));
+  EXPECT_TRUE(seen.count("--voxel-resolution"));
+}
+
+TEST(ConfigDescription, EveryFieldRoundTripsThroughJson) {
+  OdometryConfig changed;
+  changed.method = "gicp";
+  changed.voxel_size = 0.37;
+  changed.merge_threshold = 9;
+  changed.deskew = false;
+  changed.registration.voxel_resolution = 2.5;
+  changed.registration.solver.kernel.type = KernelType::kTukey;
+  changed.registration.solver.max_iterations = 11;
+  changed.registration.loam.rings = 16;
+  const std::string text = odometry_config_to_json(changed);
+  const OdometryConfig back = odometry_config_from_json(text, "test");
+  EXPECT_EQ(odometry_config_to_json(back), text);
+  EXPECT_EQ(back.registration.solver.kernel.type, KernelType::kTukey);
+  EXPECT_EQ(back.registration.loam.rings, 16);
+  EXPECT_NE(text, odometry_config_to_json(OdometryConfig{}));
+}
+
+TEST(ConfigDescription, OnlyTheGivenFlagsOverrideTheFile) {
+  OdometryConfig file;
+  file.voxel_size = 0.4;
+  file.map_radius = 30.0;
+  file.registration.solver.max_iterations = 7;
+  OdometryConfig command_line;  // defaults, except what the user typed
+  command_line.voxel_size = 0.3;
+  command_line.registration.solver.max_iterations = 12;
+  const auto given = [](const std::string& flag) {
+    return flag == "--voxel" || flag == "--max-iterations";
+  };
+  const OdometryConfig merged = override_given_flags(file, command_line, given);
+  EXPECT_EQ(merged.voxel_size, 0.3);
+  EXPECT_EQ(merged.registration.solver.max_iterations, 12);
+  EXPECT_EQ(merged.map_radius, 30.0);  // from the file
+  EXPECT_EQ(merged.method, file.method);
+}
+
+TEST(ConfigDescription, UnknownKeysAndBadKernelsNameTheKey) {
+  try {
+    odometry_config_from_json(R"({"registration": {"solver": {"kernal": "huber"}}})", "my.json");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("registration.solver.kernal"), std::string::npos)
+        << e.what();
+  }
+  try {
+    odometry_config_from_json(R"({"registration": {"solver": {"kernel": "l1"}}})", "my.json");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("my.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("registration.solver.kernel"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace scanmatch
