@@ -22,20 +22,20 @@ struct LoamPlaneFactor {
   bool linearize(const Pose& T, std::size_t i, LinearSystem& system,
                  const RobustKernel& kernel) const {
     const Eigen::Vector3d p = source.points[i].cast<double>(), x = T * p;
-    std::size_t idx[kLoamCandidates];
-    float d2[kLoamCandidates];
-    const std::size_t found = tree.knn(x.cast<float>(), kLoamCandidates, idx, d2);
-    if (found < 3 || d2[0] > max_distance * max_distance) return false;
+    LoamCandidates near;
+    if (!near.search(tree, x, max_distance, 3)) return false;
+    const std::size_t* idx = near.index;
+    const std::size_t found = near.count;
     const int ring_q = target.ring[idx[0]];
-    std::size_t m = kLoamCandidates, r = kLoamCandidates;
+    std::size_t m = LoamCandidates::kMax, r = LoamCandidates::kMax;
     for (std::size_t k = 1; k < found; ++k) {
       const int ring = target.ring[idx[k]];
-      if (m == kLoamCandidates && ring == ring_q) m = k;
-      if (r == kLoamCandidates && std::abs(ring - ring_q) == 1) r = k;
+      if (m == LoamCandidates::kMax && ring == ring_q) m = k;
+      if (r == LoamCandidates::kMax && std::abs(ring - ring_q) == 1) r = k;
     }
     // Fall back to the nearest other points where the rings do not offer both.
-    if (m == kLoamCandidates) m = (r == 1) ? 2 : 1;
-    if (r == kLoamCandidates) r = (m == 1) ? 2 : 1;
+    if (m == LoamCandidates::kMax) m = (r == 1) ? 2 : 1;
+    if (r == LoamCandidates::kMax) r = (m == 1) ? 2 : 1;
     const Eigen::Vector3d q = target.points[idx[0]].cast<double>();
     const Eigen::Vector3d n =
         (q - target.points[idx[r]].cast<double>()).cross(q - target.points[idx[m]].cast<double>());
