@@ -61,7 +61,9 @@ class Db3Bag : public BagReader {
 
   void select(const std::vector<std::string>& names) override {
     check_topics(names);
-    std::string sql = "SELECT id, topic_id, timestamp, data FROM messages";
+    // Sorting only the small columns: the blobs are fetched by id (the table's key) one by one,
+    // so a large bag is not copied through SQLite's sorter.
+    std::string sql = "SELECT id, topic_id, timestamp FROM messages";
     std::string ids;
     for (const auto& [id, name] : ids_)
       for (const std::string& wanted : names)
@@ -77,6 +79,7 @@ class Db3Bag : public BagReader {
     sql += " ORDER BY timestamp, id";
     query_.reset();
     query_ = prepare(sql.c_str());
+    if (!data_) data_ = prepare("SELECT data FROM messages WHERE id = ?");
   }
 
   bool next(BagMessage& message) override {
@@ -91,8 +94,12 @@ class Db3Bag : public BagReader {
     message.topic = topic.name;
     message.type = topic.type;
     message.encoding = topic.encoding;
-    const void* blob = sqlite3_column_blob(query_.get(), 3);
-    const int size = sqlite3_column_bytes(query_.get(), 3);
+    sqlite3_reset(data_.get());
+    sqlite3_bind_int64(data_.get(), 1, row);
+    if (sqlite3_step(data_.get()) != SQLITE_ROW)
+      fail_sql("cannot read message row " + std::to_string(row));
+    const void* blob = sqlite3_column_blob(data_.get(), 0);
+    const int size = sqlite3_column_bytes(data_.get(), 0);
     message.data.assign(static_cast<const char*>(blob), blob ? static_cast<std::size_t>(size) : 0);
     message.where = "message row " + std::to_string(row);
     return true;
@@ -115,7 +122,7 @@ class Db3Bag : public BagReader {
   }
 
   std::unique_ptr<sqlite3, CloseDb> db_;
-  Statement query_;
+  Statement query_, data_;
   std::map<std::int64_t, std::string> ids_;
 };
 
