@@ -12,6 +12,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/bag/bag.hpp"
 #include "scanmatch/io/bag/ros_messages.hpp"
+#include "test_helpers.hpp"
 
 namespace scanmatch {
 namespace {
@@ -207,10 +208,10 @@ void expect_case(BagReader& bag, const Case& c, const std::string& encoding) {
   EXPECT_FALSE(bag.fault());
 }
 
+/// A file in a folder of this test process, removed at exit.
 std::string temp_path(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "scanmatch_bag_tests";
-  fs::create_directories(dir);
-  return (dir / name).string();
+  static const scanmatch::testing::TempDir dir;
+  return dir.file(name);
 }
 
 std::string write_temp(const std::string& name, const std::string& bytes) {
