@@ -1,6 +1,7 @@
 // `scanmatch info FILE|FOLDER`: what a file or folder holds. Clouds by extension (.pcd .ply .bin
 // .xyz .csv); a .txt whose first data line has 12 or 8 numbers is a trajectory (KITTI or TUM),
-// otherwise a text cloud; .log files are CARMEN logs; folders are sequences.
+// otherwise a text cloud; .log files are CARMEN logs; folders are sequences; .bag, .db3 and .mcap
+// files (and ROS 2 bag folders) are bags: their topics, types and message counts.
 
 #include <fmt/format.h>
 
@@ -10,6 +11,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/file_kind.hpp"
+#include "scanmatch/io/bag/bag.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/sequence.hpp"
@@ -89,9 +91,28 @@ nlohmann::ordered_json sequence_info(const std::string& path) {
   return j;
 }
 
+nlohmann::ordered_json bag_info(const std::string& path) {
+  const auto bag = open_bag(path);
+  nlohmann::ordered_json topics = nlohmann::ordered_json::array();
+  for (const BagTopic& t : bag->topics())
+    topics.push_back({{"name", t.name},
+                      {"type", t.type},
+                      {"encoding", t.encoding},
+                      {"messages", t.message_count}});
+  nlohmann::ordered_json j = {{"kind", "bag"}, {"format", bag->format()}, {"topics", topics}};
+  if (bag->fault()) j["fault"] = *bag->fault();
+  return j;
+}
+
 void print_plain(const nlohmann::ordered_json& j) {
   for (const auto& [key, value] : j.items()) {
-    if (value.is_string())
+    if (key == "topics" && value.is_array()) {  // one line per bag topic
+      fmt::print("topics: {}\n", value.size());
+      for (const auto& t : value)
+        fmt::print("  {}  {}  {}  {} messages\n", t["name"].get<std::string>(),
+                   t["type"].get<std::string>(), t["encoding"].get<std::string>(),
+                   t["messages"].get<std::uint64_t>());
+    } else if (value.is_string())
       fmt::print("{}: {}\n", key, value.get<std::string>());
     else
       fmt::print("{}: {}\n", key, value.dump());
@@ -104,14 +125,14 @@ void add_info_command(CLI::App& app) {
   auto path = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
   auto* cmd = app.add_subcommand(
-      "info", "Describe a point cloud, trajectory, CARMEN log or sequence folder");
+      "info", "Describe a point cloud, trajectory, CARMEN log, sequence folder or bag");
   cmd->add_option("PATH", *path, "File or folder")->required();
   cmd->add_flag("--json", *json, "Print JSON");
   cmd->callback([path, json] {
     nlohmann::ordered_json j;
     switch (detect_file_kind(*path)) {
-      case FileKind::kCloud:
-        j = cloud_info(*path);
+      case FileKind::kCloud:  // .bag, .db3 and .mcap have no cloud extension
+        j = is_bag_path(*path) ? bag_info(*path) : cloud_info(*path);
         break;
       case FileKind::kTrajectory:
         j = trajectory_info(*path);
@@ -119,8 +140,8 @@ void add_info_command(CLI::App& app) {
       case FileKind::kCarmen:
         j = carmen_info(*path);
         break;
-      case FileKind::kSequence:
-        j = sequence_info(*path);
+      case FileKind::kSequence:  // or a ROS 2 bag folder
+        j = is_bag_path(*path) ? bag_info(*path) : sequence_info(*path);
         break;
     }
     j["path"] = *path;

@@ -8,6 +8,7 @@
 
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/odometry/run2d.hpp"
 
 namespace scanmatch::cli {
@@ -19,7 +20,7 @@ extern "C" void on_map2d_interrupt(int) {
 }
 
 struct Map2DCommand {
-  std::string sequence, out, initial = "identity";
+  std::string sequence, out, initial = "identity", topic;
   std::size_t scans = 0;
   std::uint64_t seed = 1;
   bool no_motion_distortion = false;
@@ -39,9 +40,12 @@ void add_map2d_command(CLI::App& app) {
   auto* cmd =
       app.add_subcommand("map2d", "2D laser scan-to-scan mapping: poses and an occupancy grid");
   cmd->add_option("SEQUENCE", c->sequence,
-                  "A CARMEN log (.log, .log.gz), a simulated 2D data set folder or sim:room-2d")
+                  "A CARMEN log (.log, .log.gz), a simulated 2D data set folder, sim:room-2d or a "
+                  "ROS bag (.bag, .db3, .mcap) with LaserScan messages")
       ->required();
   cmd->add_option("--out", c->out, "Run folder (created)")->required();
+  cmd->add_option("--topic", c->topic,
+                  "Bags (.bag, .db3, .mcap): the LaserScan topic (default: the only one)");
   cmd->add_option("--method", r.method, "sparse-icp, icp, icp-kdtree, pl-icp or normal-icp")
       ->capture_default_str();
   cmd->add_option("--initial", c->initial, "Initial guess: constant-velocity or identity")
@@ -101,7 +105,14 @@ void add_map2d_command(CLI::App& app) {
     c->run.mapper.registration.search_angle = c->search_angle_deg * M_PI / 180;
     c->run.mapper.keyframe_angle = c->keyframe_angle_deg * M_PI / 180;
     c->run.mapper.registration.path_rules.shared = parse_shared_rows(c->shared_rows);
-    Scans2D input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
+    Scans2D input;
+    if (is_bag_path(c->sequence)) {
+      input.scans = read_bag_laser_scans(c->sequence, c->topic, c->scans);
+      if (input.scans.empty()) throw Error(c->sequence + ": the topic holds no laser scans");
+      input.description = c->sequence;
+    } else {
+      input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
+    }
     if (c->rotation_period >= 0.0) input.rotation_period = c->rotation_period;
     interrupted.store(false);
     c->run.stop = &interrupted;

@@ -1,5 +1,5 @@
 // `scanmatch odometry SEQUENCE --method NAME --out RUNDIR`: poses, timing, summary and map of a
-// whole sequence (folder, KITTI sequence, simulator data set or sim:PRESET).
+// whole sequence (folder, KITTI sequence, simulator data set, sim:PRESET or a bag's cloud topic).
 
 #include <fmt/format.h>
 
@@ -11,6 +11,7 @@
 #include "apps/config_options.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
+#include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/run.hpp"
@@ -25,7 +26,7 @@ extern "C" void on_interrupt(int) {
 }
 
 struct OdometryCommand {
-  std::string sequence, out, config_file;
+  std::string sequence, out, config_file, topic;
   std::size_t frames = 0;
   std::uint64_t seed = 1;
   bool quiet = false, no_fine = false, no_map_update = false, no_deskew = false;
@@ -50,7 +51,8 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
   const bool simulated = c.sequence.rfind("sim:", 0) == 0;
   if (!simulated && !std::filesystem::exists(c.sequence))
     throw Error(c.sequence + ": no such sequence (a folder, a KITTI sequence or sim:PRESET)");
-  const auto source = sim::open_sequence(c.sequence, sim_options);
+  const auto source = is_bag_path(c.sequence) ? open_bag_sequence(c.sequence, c.topic)
+                                              : sim::open_sequence(c.sequence, sim_options);
   c.run.out_dir = c.out;
   c.run.max_frames = c.frames;
   c.run.quiet = c.quiet;
@@ -110,10 +112,13 @@ void add_odometry_command(CLI::App& app) {
       "odometry", "LiDAR odometry over a sequence: poses, timing, summary and optionally a map");
   OdometryConfig& o = c->config;
   cmd->add_option("SEQUENCE", c->sequence,
-                  "A folder of PCD/PLY/BIN frames, a KITTI sequence, a simulated data set or "
-                  "sim:PRESET")
+                  "A folder of PCD/PLY/BIN frames, a KITTI sequence, a simulated data set, "
+                  "sim:PRESET or a ROS bag (.bag, .db3, .mcap)")
       ->required();
   cmd->add_option("--out", c->out, "Run folder (created)")->required();
+  cmd->add_option(
+      "--topic", c->topic,
+      "Bags (.bag, .db3, .mcap): the PointCloud2 or Livox topic (default: the only one)");
   cmd->add_option("--config", c->config_file,
                   "JSON configuration (as written to RUNDIR/config.json); options given here win");
   cmd->add_option("--frames", c->frames, "Process at most this many frames (0: all)");
