@@ -9,6 +9,7 @@
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/odometry/run2d.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch::cli {
 namespace {
@@ -42,7 +43,7 @@ void add_map2d_command(CLI::App& app) {
                   "A CARMEN log (.log, .log.gz), a simulated 2D data set folder or sim:room-2d")
       ->required();
   cmd->add_option("--out", c->out, "Run folder (created)")->required();
-  cmd->add_option("--method", r.method, "sparse-icp, icp, icp-kdtree, pl-icp or normal-icp")
+  cmd->add_option("--method", r.method, "One of: " + registration_2d_method_list())
       ->capture_default_str();
   cmd->add_option("--initial", c->initial, "Initial guess: constant-velocity or identity")
       ->capture_default_str();

@@ -9,9 +9,10 @@
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/registration/methods.hpp"
-#include "scanmatch/registration/scan2d.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch::cli {
 namespace {
@@ -23,6 +24,7 @@ struct RegisterCommand {
   double voxel = 0.1;
   bool json = false;
   RegistrationOptions options;
+  const CLI::Option *method = nullptr, *max_distance = nullptr;  ///< given: they apply to --2d
 };
 
 // "16 numbers" (row-major 4x4) or "x,y,z,roll,pitch,yaw" (metres and degrees).
@@ -76,11 +78,7 @@ LaserScan2D read_scan_2d(const std::string& spec) {
 
 void run_2d(RegisterCommand& c) {
   Pose2 initial = Pose2::Identity();
-  if (!c.init.empty()) {
-    const Pose p = parse_initial_guess(c.init);
-    initial = pose2(p.translation().x(), p.translation().y(),
-                    std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
-  }
+  if (!c.init.empty()) initial = planar_pose(parse_initial_guess(c.init));
   const Scan2D source = scan_from_laser(read_scan_2d(c.source));
   const Scan2D target = scan_from_laser(read_scan_2d(c.target));
   const auto start = std::chrono::steady_clock::now();
@@ -111,10 +109,10 @@ void run_2d(RegisterCommand& c) {
 
 void run(RegisterCommand& c) {
   if (c.planar) {
-    if (c.options.method != RegistrationOptions{}.method)
-      c.planar_options.method = c.options.method;
-    if (c.options.max_correspondence_distance != RegistrationOptions{}.max_correspondence_distance)
+    if (c.method->count() > 0) c.planar_options.method = c.options.method;
+    if (c.max_distance->count() > 0)
       c.planar_options.max_correspondence_distance = c.options.max_correspondence_distance;
+    check_registration_2d_method(c.planar_options.method);
     return run_2d(c);
   }
   const Pose initial = c.init.empty() ? Pose::Identity() : parse_initial_guess(c.init);
@@ -174,7 +172,8 @@ void add_register_command(CLI::App& app) {
       "Register SOURCE onto TARGET; prints the 4x4 transform mapping SOURCE into TARGET");
   cmd->add_option("SOURCE", c->source, "Source cloud")->required();
   cmd->add_option("TARGET", c->target, "Target cloud")->required();
-  cmd->add_option("--method", c->options.method, "One of: " + methods)->capture_default_str();
+  c->method =
+      cmd->add_option("--method", c->options.method, "One of: " + methods)->capture_default_str();
   cmd->add_option("--init", c->init,
                   "Initial guess: 16 numbers (row-major 4x4) or x,y,z,roll,pitch,yaw (m, deg)");
   cmd->add_option("--voxel", c->voxel, "Voxel downsampling of both clouds, m (0: none)")
@@ -183,9 +182,9 @@ void add_register_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-iterations", c->options.solver.max_iterations, "Iteration limit")
       ->capture_default_str();
-  cmd->add_option("--max-distance", c->options.max_correspondence_distance,
-                  "Correspondence distance, m")
-      ->capture_default_str();
+  c->max_distance = cmd->add_option("--max-distance", c->options.max_correspondence_distance,
+                                    "Correspondence distance, m")
+                        ->capture_default_str();
   cmd->add_option("--resolution", c->options.voxel_resolution,
                   "Gaussian voxel size for vgicp, ndt, ctf-fine, m")
       ->capture_default_str();
@@ -199,8 +198,9 @@ void add_register_command(CLI::App& app) {
                 "Levenberg-Marquardt instead of Gauss-Newton");
   cmd->add_flag("--json", c->json, "Print JSON");
   cmd->add_flag("--2d", c->planar,
-                "2D laser scans: SOURCE and TARGET are CARMEN logs, LOG or LOG:INDEX; methods "
-                "sparse-icp (default), icp, icp-kdtree, pl-icp, normal-icp");
+                "2D laser scans: SOURCE and TARGET are CARMEN logs, LOG or LOG:INDEX; methods " +
+                    registration_2d_method_list() + " (default " + Registration2DOptions{}.method +
+                    ")");
   cmd->add_option("--search-window", c->planar_options.search_window,
                   "2D: correlative coarse search over +- this many m first (0: off)");
   cmd->callback([c] { run(*c); });
