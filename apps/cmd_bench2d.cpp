@@ -11,10 +11,12 @@
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/eval/metrics2d.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/odometry/mapper2d.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
 #include "scanmatch/sim/scan_pairs.hpp"
 
 namespace scanmatch::cli {
@@ -78,8 +80,7 @@ struct Spread {
 Spread spread(const std::vector<double>& v) {
   Spread s;
   if (v.empty()) return s;
-  for (double x : v) s.mean += x;
-  s.mean /= static_cast<double>(v.size());
+  s.mean = mean_of(v);
   for (double x : v) s.std += (x - s.mean) * (x - s.mean);
   s.std = std::sqrt(s.std / static_cast<double>(v.size()));
   return s;
@@ -202,10 +203,10 @@ void add_bench2d_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-rotation", o->max_rotation_deg, "Largest rotation of a pair, deg")
       ->capture_default_str();
-  cmd->add_option(
-      "--method", o->methods,
-      "Methods (default: all, sparse-icp-paper: sparse-icp with the paper's settings, and "
-      "pl-icp-fitted: pl-icp with sparse-icp's fitted lines)");
+  cmd->add_option("--method", o->methods,
+                  "Methods: " + registration_2d_method_list() + ", " + kPaperVariant +
+                      " (sparse-icp with the paper's settings) and " + kFittedPlIcp +
+                      " (pl-icp with sparse-icp's fitted lines); default: all");
   cmd->add_option("--log", o->logs, "CARMEN logs to map scan to scan (.log or .log.gz)");
   cmd->add_option("--search-window", o->search_window,
                   "Add variants with the correlative search over +- this many m (0: none)")

@@ -10,6 +10,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/odometry/run2d.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch::cli {
 namespace {
@@ -46,7 +47,7 @@ void add_map2d_command(CLI::App& app) {
   cmd->add_option("--out", c->out, "Run folder (created)")->required();
   cmd->add_option("--topic", c->topic,
                   "Bags (.bag, .db3, .mcap): the LaserScan topic (default: the only one)");
-  cmd->add_option("--method", r.method, "sparse-icp, icp, icp-kdtree, pl-icp or normal-icp")
+  cmd->add_option("--method", r.method, "One of: " + registration_2d_method_list())
       ->capture_default_str();
   cmd->add_option("--initial", c->initial, "Initial guess: constant-velocity or identity")
       ->capture_default_str();

@@ -10,9 +10,10 @@
 #include "apps/config_options.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/registration/methods.hpp"
-#include "scanmatch/registration/scan2d.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch::cli {
 namespace {
@@ -24,6 +25,7 @@ struct RegisterCommand {
   double voxel = 0.1;
   bool json = false;
   RegistrationOptions options;
+  const CLI::Option *method = nullptr, *max_distance = nullptr;  ///< given: they apply to --2d
 };
 
 // "16 numbers" (row-major 4x4) or "x,y,z,roll,pitch,yaw" (metres and degrees).
@@ -77,11 +79,7 @@ LaserScan2D read_scan_2d(const std::string& spec) {
 
 void run_2d(RegisterCommand& c) {
   Pose2 initial = Pose2::Identity();
-  if (!c.init.empty()) {
-    const Pose p = parse_initial_guess(c.init);
-    initial = pose2(p.translation().x(), p.translation().y(),
-                    std::atan2(p.linear()(1, 0), p.linear()(0, 0)));
-  }
+  if (!c.init.empty()) initial = planar_pose(parse_initial_guess(c.init));
   const Scan2D source = scan_from_laser(read_scan_2d(c.source));
   const Scan2D target = scan_from_laser(read_scan_2d(c.target));
   const auto start = std::chrono::steady_clock::now();
@@ -112,10 +110,10 @@ void run_2d(RegisterCommand& c) {
 
 void run(RegisterCommand& c) {
   if (c.planar) {
-    if (c.options.method != RegistrationOptions{}.method)
-      c.planar_options.method = c.options.method;
-    if (c.options.max_correspondence_distance != RegistrationOptions{}.max_correspondence_distance)
+    if (c.method->count() > 0) c.planar_options.method = c.options.method;
+    if (c.max_distance->count() > 0)
       c.planar_options.max_correspondence_distance = c.options.max_correspondence_distance;
+    check_registration_2d_method(c.planar_options.method);
     return run_2d(c);
   }
   const Pose initial = c.init.empty() ? Pose::Identity() : parse_initial_guess(c.init);
@@ -172,8 +170,9 @@ void add_register_command(CLI::App& app) {
       "Register SOURCE onto TARGET; prints the 4x4 transform mapping SOURCE into TARGET");
   cmd->add_option("SOURCE", c->source, "Source cloud")->required();
   cmd->add_option("TARGET", c->target, "Target cloud")->required();
-  cmd->add_option("--method", c->options.method, "One of: " + registration_method_list())
-      ->capture_default_str();
+  c->method =
+      cmd->add_option("--method", c->options.method, "One of: " + registration_method_list())
+          ->capture_default_str();
   cmd->add_option("--init", c->init,
                   "Initial guess: 16 numbers (row-major 4x4) or x,y,z,roll,pitch,yaw (m, deg)");
   cmd->add_option("--voxel", c->voxel, "Voxel downsampling of both clouds, m (0: none)")
@@ -181,10 +180,12 @@ void add_register_command(CLI::App& app) {
   cmd->add_option("--threads", c->options.solver.num_threads, "Threads for linearisation")
       ->capture_default_str();
   add_config_options(cmd, c->options);
+  c->max_distance = cmd->get_option("--max-distance");
   cmd->add_flag("--json", c->json, "Print JSON");
   cmd->add_flag("--2d", c->planar,
-                "2D laser scans: SOURCE and TARGET are CARMEN logs, LOG or LOG:INDEX; methods "
-                "sparse-icp (default), icp, icp-kdtree, pl-icp, normal-icp");
+                "2D laser scans: SOURCE and TARGET are CARMEN logs, LOG or LOG:INDEX; methods " +
+                    registration_2d_method_list() + " (default " + Registration2DOptions{}.method +
+                    ")");
   cmd->add_option("--search-window", c->planar_options.search_window,
                   "2D: correlative coarse search over +- this many m first (0: off)");
   std::string methods = "3D methods (what each builds first):\n";

@@ -175,6 +175,35 @@ TEST(Geometry, KdTreeMatchesBruteForce) {
   EXPECT_FALSE(tree.nearest(Point(100, 100, 100), 1.0f, index, d2));
 }
 
+TEST(Geometry, KdTree2MatchesBruteForce) {
+  // The same tree in 2D and double precision, as the 2D methods use it.
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-10, 10);
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 1000; ++i) points.emplace_back(u(rng), u(rng));
+  const KdTree2 tree(points);
+  EXPECT_EQ(tree.size(), points.size());
+  for (int q = 0; q < 100; ++q) {
+    const Eigen::Vector2d query(u(rng), u(rng));
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < points.size(); ++i)
+      if ((points[i] - query).squaredNorm() < (points[best] - query).squaredNorm()) best = i;
+    std::size_t index;
+    double d2;
+    ASSERT_TRUE(tree.nearest(query, 1e9, index, d2));
+    EXPECT_EQ(index, best);
+    EXPECT_DOUBLE_EQ(d2, (points[best] - query).squaredNorm());
+    std::size_t indices[4];
+    double distances[4];
+    EXPECT_EQ(tree.knn(query, 4, indices, distances), 4u);
+    EXPECT_EQ(indices[0], best);
+    for (int k = 1; k < 4; ++k) EXPECT_LE(distances[k - 1], distances[k]);
+  }
+  std::size_t index;
+  double d2;
+  EXPECT_FALSE(tree.nearest(Eigen::Vector2d(100, 100), 1.0, index, d2));
+}
+
 TEST(Geometry, GaussianMapMergeEqualsBatchStatistics) {
   std::mt19937 rng(7);
   std::normal_distribution<double> n(0.0, 0.1);

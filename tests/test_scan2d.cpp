@@ -11,7 +11,12 @@
 #include "scanmatch/eval/metrics2d.hpp"
 #include "scanmatch/features/angle_histogram.hpp"
 #include "scanmatch/odometry/run2d.hpp"
-#include "scanmatch/registration/scan2d.hpp"
+#include "scanmatch/registration/planar/correlative_search.hpp"
+#include "scanmatch/registration/planar/correspondence_path.hpp"
+#include "scanmatch/registration/planar/point_to_line.hpp"
+#include "scanmatch/registration/planar/point_to_point.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
+#include "scanmatch/registration/planar/sparse_icp.hpp"
 #include "scanmatch/sim/scan_pairs.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
@@ -327,6 +332,27 @@ TEST(Scan2D, BadInputGivesClearErrors) {
   EXPECT_THROW(parse_shared_rows("keep"), Error);
 }
 
+TEST(Scan2D, MethodTableGivesTheNamesAndTheErrors) {
+  const auto& methods = registration_2d_methods();
+  ASSERT_FALSE(methods.empty());
+  EXPECT_EQ(methods.front().name, Registration2DOptions{}.method);  // the first is the default
+  std::vector<std::string> names;
+  for (const Registration2DMethod& m : methods) {
+    names.emplace_back(m.name);
+    EXPECT_GE(m.min_points, 3u) << m.name;
+    EXPECT_NE(m.run, nullptr) << m.name;
+  }
+  EXPECT_EQ(names, registration_2d_method_names());
+  EXPECT_EQ(registration_2d_method_list(), "sparse-icp, icp, icp-kdtree, pl-icp, normal-icp");
+  try {
+    check_registration_2d_method("gicp");
+    FAIL() << "a 3D method accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "unknown 2D registration method 'gicp' (valid: " +
+                                         registration_2d_method_list() + ")");
+  }
+}
+
 TEST(Metrics2D, RelativeErrorOfAKnownDrift) {
   // The estimate moves 1.1 m per step where the reference moves 1.0 m, and turns 1 deg more.
   std::vector<Pose2> reference, estimate;
@@ -486,6 +512,40 @@ TEST(Map2D, RegisterAcceptsTwoDimensionalScans) {
   const auto bad = scanmatch::testing::run_cli("register --2d " + log + ":11 " + log + ":500");
   EXPECT_NE(bad.status, 0);
   EXPECT_NE(bad.output.find("scan 500"), std::string::npos) << bad.output;
+}
+
+TEST(Map2D, TwoDimensionalCommandsRejectOtherMethods) {
+  // A 3D method name with --2d is an error naming the 2D methods, not a silent sparse-icp.
+  scanmatch::testing::TempDir dir;
+  CarmenLog log;
+  for (int s = 0; s < 2; ++s) {
+    LaserScan2D scan;
+    scan.angle_min = -M_PI;
+    scan.angle_increment = M_PI / 180;
+    scan.ranges.assign(360, 2.0f + 0.1f * s);
+    log.scans.push_back(scan);
+  }
+  const std::string path = dir.file("two.log");
+  write_carmen_log(path, log);
+  const std::string valid = "sparse-icp, icp, icp-kdtree, pl-icp, normal-icp";
+  for (const std::string method : {"gicp", "no-such"}) {
+    const auto r = scanmatch::testing::run_cli("register --2d " + path + ":1 " + path +
+                                               ":0 --method " + method);
+    EXPECT_NE(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("'" + method + "' (valid: " + valid + ")"), std::string::npos)
+        << r.output;
+  }
+  const auto bench = scanmatch::testing::run_cli("bench2d --pairs 0 --method gicp");
+  EXPECT_NE(bench.status, 0);
+  EXPECT_NE(bench.output.find("'gicp' (valid: " + valid + ")"), std::string::npos) << bench.output;
+  const auto map = scanmatch::testing::run_cli("map2d " + path + " --quiet --method gicp --out " +
+                                               dir.file("run"));
+  EXPECT_NE(map.status, 0);
+  EXPECT_NE(map.output.find("'gicp' (valid: " + valid + ")"), std::string::npos) << map.output;
+  // A 2D method still runs.
+  const auto ok = scanmatch::testing::run_cli("register --2d " + path + ":1 " + path +
+                                              ":0 --method icp --json");
+  EXPECT_EQ(ok.status, 0) << ok.output;
 }
 
 TEST(Map2D, RealCarmenLogBeatsTheCsmBaseline) {

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "scanmatch/registration/scan2d.hpp"
+#include "scanmatch/core/scan2d.hpp"
 
 namespace scanmatch {
 

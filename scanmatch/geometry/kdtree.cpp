@@ -4,10 +4,12 @@
 
 namespace scanmatch {
 namespace {
+template <class PointT>
 struct PointsAdaptor {
-  const std::vector<Point>& points;
+  using Scalar = typename PointT::Scalar;
+  const std::vector<PointT>& points;
   std::size_t kdtree_get_point_count() const { return points.size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t dim) const {
+  Scalar kdtree_get_pt(std::size_t i, std::size_t dim) const {
     return points[i][static_cast<int>(dim)];
   }
   template <class Box>
@@ -15,33 +17,42 @@ struct PointsAdaptor {
     return false;
   }
 };
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>,
-                                                 PointsAdaptor, 3, std::size_t>;
 }  // namespace
 
-struct KdTree::Impl {
-  explicit Impl(const std::vector<Point>& points)
-      : adaptor{points}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
+template <class PointT>
+struct BasicKdTree<PointT>::Impl {
+  static constexpr int kDim = PointT::RowsAtCompileTime;
+  using Adaptor = PointsAdaptor<PointT>;
+  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<Scalar, Adaptor>,
+                                                   Adaptor, kDim, std::size_t>;
+  explicit Impl(const std::vector<PointT>& points)
+      : adaptor{points}, tree(kDim, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
     tree.buildIndex();
   }
-  PointsAdaptor adaptor;
+  Adaptor adaptor;
   Tree tree;
 };
 
-KdTree::KdTree(const std::vector<Point>& points) : impl_(std::make_unique<Impl>(points)) {}
-KdTree::~KdTree() = default;
-KdTree::KdTree(KdTree&&) noexcept = default;
+template <class PointT>
+BasicKdTree<PointT>::BasicKdTree(const std::vector<PointT>& points)
+    : impl_(std::make_unique<Impl>(points)) {}
+template <class PointT>
+BasicKdTree<PointT>::~BasicKdTree() = default;
+template <class PointT>
+BasicKdTree<PointT>::BasicKdTree(BasicKdTree&&) noexcept = default;
 
-std::size_t KdTree::size() const {
+template <class PointT>
+std::size_t BasicKdTree<PointT>::size() const {
   return impl_->adaptor.points.size();
 }
 
-bool KdTree::nearest(const Point& query, float max_squared_distance, std::size_t& index,
-                     float& squared_distance) const {
+template <class PointT>
+bool BasicKdTree<PointT>::nearest(const PointT& query, Scalar max_squared_distance,
+                                  std::size_t& index, Scalar& squared_distance) const {
   if (size() == 0) return false;
   std::size_t i = 0;
-  float d = 0.0f;
-  nanoflann::KNNResultSet<float, std::size_t> result(1);
+  Scalar d = 0;
+  nanoflann::KNNResultSet<Scalar, std::size_t> result(1);
   result.init(&i, &d);
   impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
   if (d > max_squared_distance) return false;
@@ -50,13 +61,17 @@ bool KdTree::nearest(const Point& query, float max_squared_distance, std::size_t
   return true;
 }
 
-std::size_t KdTree::knn(const Point& query, std::size_t k, std::size_t* indices,
-                        float* squared_distances) const {
+template <class PointT>
+std::size_t BasicKdTree<PointT>::knn(const PointT& query, std::size_t k, std::size_t* indices,
+                                     Scalar* squared_distances) const {
   if (size() == 0 || k == 0) return 0;
-  nanoflann::KNNResultSet<float, std::size_t> result(k);
+  nanoflann::KNNResultSet<Scalar, std::size_t> result(k);
   result.init(indices, squared_distances);
   impl_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
   return result.size();
 }
+
+template class BasicKdTree<Point>;
+template class BasicKdTree<Eigen::Vector2d>;
 
 }  // namespace scanmatch

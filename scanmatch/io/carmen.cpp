@@ -164,4 +164,30 @@ void write_carmen_log(const std::string& path, const CarmenLog& log, CarmenLaser
   write_file_atomic(path, out);
 }
 
+Scan2D scan_from_laser(const LaserScan2D& scan, double min_range, double miss_range,
+                       double rotation_period) {
+  Scan2D out;
+  const double max_range = scan.max_range;
+  const double free_range = miss_range > 0.0 ? miss_range : max_range;
+  out.points.reserve(scan.ranges.size());
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double range = scan.ranges[i];
+    const double angle = scan.angle_min + static_cast<double>(i) * scan.angle_increment;
+    const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
+    if (!std::isfinite(range)) continue;
+    if (range >= max_range) {
+      out.misses.push_back(free_range * direction);
+      continue;
+    }
+    if (range <= min_range) continue;
+    out.points.push_back(range * direction);
+    if (rotation_period > 0.0)
+      out.times.push_back(rotation_period * static_cast<double>(i) *
+                          std::abs(scan.angle_increment) / (2 * M_PI));
+  }
+  const double span = static_cast<double>(scan.ranges.size()) * std::abs(scan.angle_increment);
+  out.circular = span > 2 * M_PI - 1.5 * std::abs(scan.angle_increment);
+  return out;
+}
+
 }  // namespace scanmatch

@@ -1,6 +1,8 @@
 #pragma once
 // CARMEN logs, the format of the classic 2D laser SLAM data sets: FLASER, ROBOTLASER1 and ODOM
-// records (read and write); other record types are counted and skipped.
+// records (read and write); other record types are counted and skipped. Their laser scans
+// (LaserScan2D, also what the simulator's 2D sensor gives) become the 2D methods' Scan2D with
+// scan_from_laser.
 
 #include <Eigen/Core>
 #include <cmath>
@@ -8,6 +10,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "scanmatch/core/scan2d.hpp"
 
 namespace scanmatch {
 
@@ -21,6 +25,14 @@ struct LaserScan2D {
   Eigen::Vector3d pose = Eigen::Vector3d::Zero();       ///< x, y, theta of the laser in the log
   Eigen::Vector3d odom_pose = Eigen::Vector3d::Zero();  ///< robot odometry x, y, theta
 };
+
+/// Valid beams (finite, range in (min_range, max_range)) as points, in beam order; `circular`
+/// when the beams cover the full circle. Beams at or beyond the maximum range become `misses`
+/// at `miss_range` (0: the scan's max range). With `rotation_period` (s per turn of the laser's
+/// mirror or head; 0: unknown) each point gets its time: beams are measured in order, one full
+/// turn taking the period.
+Scan2D scan_from_laser(const LaserScan2D& scan, double min_range = 0.05, double miss_range = 0.0,
+                       double rotation_period = 0.0);
 
 struct Odometry2D {
   double timestamp = 0.0;

@@ -5,7 +5,8 @@
 #include <cstddef>
 #include <string>
 
-#include "scanmatch/registration/scan2d.hpp"
+#include "scanmatch/core/scan2d.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch {
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "scanmatch/eval/metrics2d.hpp"
+#include "scanmatch/io/carmen.hpp"
 #include "scanmatch/odometry/grid_map.hpp"
 #include "scanmatch/odometry/mapper2d.hpp"
 

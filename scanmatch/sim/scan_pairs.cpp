@@ -11,14 +11,6 @@
 namespace scanmatch::sim {
 namespace {
 
-Eigen::Isometry2d planar(const Pose& p) {
-  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-  T.linear() =
-      Eigen::Rotation2Dd(std::atan2(p.linear()(1, 0), p.linear()(0, 0))).toRotationMatrix();
-  T.translation() = p.translation().head<2>();
-  return T;
-}
-
 double median_range(const LaserScan2D& scan) {
   std::vector<float> valid;
   for (float r : scan.ranges)
@@ -67,7 +59,7 @@ std::vector<PlanarScanPair> planar_scan_pairs(const PlanarPairOptions& options) 
   std::vector<PlanarScanPair> pairs;
   for (std::size_t i = 1; i + 1 < simulator.size() && pairs.size() < options.count; i += 2) {
     PlanarScanPair p{simulator.scan_2d(i), simulator.scan_2d(i + 1),
-                     planar(simulator.pose(i)).inverse() * planar(simulator.pose(i + 1))};
+                     planar_pose(simulator.pose(i)).inverse() * planar_pose(simulator.pose(i + 1))};
     // Inside a piece of furniture every return is a few centimetres away.
     if (median_range(p.reference) < 0.8 || median_range(p.current) < 0.8) continue;
     pairs.push_back(std::move(p));

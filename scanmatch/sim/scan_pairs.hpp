@@ -3,17 +3,17 @@
 // the room-2d scene: the material of the 2D paper's Table 1 (one scan pair, registered by every
 // method), repeated many times.
 
-#include <Eigen/Geometry>
 #include <cstdint>
 #include <vector>
 
+#include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/io/carmen.hpp"
 
 namespace scanmatch::sim {
 
 struct PlanarScanPair {
   LaserScan2D reference, current;
-  Eigen::Isometry2d truth;  ///< maps current-scan points into the reference scan's frame
+  Pose2 truth;  ///< maps current-scan points into the reference scan's frame
 };
 
 struct PlanarPairOptions {

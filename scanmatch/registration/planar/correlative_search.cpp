@@ -1,14 +1,13 @@
-// Correlative scan matching over a window (Olson's idea, our own two-level branch and bound): the
-// reference becomes a smoothed likelihood grid; each rotation of the current scan is scored at
-// every translation of the window. A max-filtered copy of the grid bounds the score of a whole
-// block of translations, so most blocks are dismissed without looking at their cells.
+#include "scanmatch/registration/planar/correlative_search.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/registration/scan2d.hpp"
 
 namespace scanmatch {
 namespace {

@@ -1,0 +1,97 @@
+#include "scanmatch/registration/planar/registration2d.hpp"
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/registration/planar/correlative_search.hpp"
+
+namespace scanmatch {
+
+// The methods' run functions, each defined in its own file of registration/planar/.
+Registration2DRun run_sparse_icp, run_icp, run_icp_kdtree, run_pl_icp, run_normal_icp;
+
+namespace {
+
+void check_scan(const Scan2D& scan, const char* which, std::size_t min_points) {
+  if (scan.points.size() < min_points)
+    throw Error(std::string("2D registration: the ") + which + " scan has " +
+                std::to_string(scan.points.size()) + " valid points, at least " +
+                std::to_string(min_points) + " are needed");
+  for (const Eigen::Vector2d& p : scan.points)
+    if (!p.allFinite())
+      throw Error(std::string("2D registration: the ") + which + " scan has a non-finite point");
+}
+
+void check_options(const Registration2DOptions& o) {
+  if (!(o.max_correspondence_distance > 0.0))
+    throw Error("2D registration: the correspondence distance must be positive");
+  if (o.max_iterations < 1) throw Error("2D registration: at least one iteration is needed");
+  if (o.sparse_step != "svd" && o.sparse_step != "point-to-line")
+    throw Error("2D registration: unknown sparse-icp step '" + o.sparse_step +
+                "' (svd, point-to-line)");
+  if (o.path_rules.max_step < 1 || o.path_rules.max_run < 1)
+    throw Error("2D registration: the path's max step and max run must be at least 1");
+  if (!(o.sparse_line_radius >= 0.0) || !(o.pl_line_radius >= 0.0))
+    throw Error("2D registration: a line radius must be 0 or positive");
+  if (!(o.sparse_keep_fraction > 0.0 && o.sparse_keep_fraction <= 1.0) ||
+      !(o.keep_fraction > 0.0 && o.keep_fraction <= 1.0))
+    throw Error("2D registration: a keep fraction must be in (0, 1]");
+  if (!(o.sparse_min_pairs >= 0.0 && o.sparse_min_pairs < 1.0))
+    throw Error("2D registration: sparse_min_pairs must be in [0, 1)");
+}
+
+}  // namespace
+
+const std::vector<Registration2DMethod>& registration_2d_methods() {
+  // The method table: a new 2D method is a file with its run function and a line here.
+  static const std::vector<Registration2DMethod> methods = {
+      {"sparse-icp", 5, "lines fitted to the reference; its bearing index once the path is lost",
+       run_sparse_icp},
+      {"icp", 5, "nothing (brute-force nearest neighbours)", run_icp},
+      {"icp-kdtree", 5, "a k-d tree of the reference", run_icp_kdtree},
+      {"pl-icp", 5, "a k-d tree of the reference (and its fitted lines with pl_line_radius)",
+       run_pl_icp},
+      {"normal-icp", 5, "a k-d tree of the reference; normals of both scans", run_normal_icp},
+  };
+  return methods;
+}
+
+const std::vector<std::string>& registration_2d_method_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const Registration2DMethod& m : registration_2d_methods()) out.emplace_back(m.name);
+    return out;
+  }();
+  return names;
+}
+
+std::string registration_2d_method_list() {
+  std::string list;
+  for (const Registration2DMethod& m : registration_2d_methods())
+    list += (list.empty() ? "" : ", ") + std::string(m.name);
+  return list;
+}
+
+const Registration2DMethod& registration_2d_method(const std::string& name) {
+  for (const Registration2DMethod& m : registration_2d_methods())
+    if (name == m.name) return m;
+  throw Error("unknown 2D registration method '" + name +
+              "' (valid: " + registration_2d_method_list() + ")");
+}
+
+void check_registration_2d_method(const std::string& method) {
+  registration_2d_method(method);
+}
+
+Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
+                                    const Registration2DOptions& o, const Pose2& initial) {
+  const Registration2DMethod& method = registration_2d_method(o.method);
+  check_options(o);
+  check_scan(current, "current", method.min_points);
+  check_scan(reference, "reference", method.min_points);
+  const Pose2 start = o.search_window > 0.0
+                          ? correlative_search(current, reference, initial, o.search_window,
+                                               o.search_angle, o.search_resolution)
+                          : initial;
+  return method.run(current, reference, o, start);
+}
+
+}  // namespace scanmatch

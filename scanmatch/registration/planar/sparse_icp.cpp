@@ -1,0 +1,169 @@
+#include "scanmatch/registration/planar/sparse_icp.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "scanmatch/features/angle_histogram.hpp"
+#include "scanmatch/registration/planar/common.hpp"
+#include "scanmatch/registration/planar/correspondence_path.hpp"
+#include "scanmatch/registration/planar/line_fitting.hpp"
+#include "scanmatch/registration/planar/point_to_line.hpp"
+#include "scanmatch/registration/planar/point_to_point.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
+
+namespace scanmatch {
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+
+/// The nearest point to `p` on the segments from reference point j to its beam-order neighbours,
+/// and the unit normal of that segment (zero when j has no usable segment: the point is then j
+/// itself). Segments longer than `max_length` span a gap, not a surface, and are not used.
+struct SegmentProjection {
+  Vec2 point, normal;
+};
+
+/// Empty when j ends a surface and `p` lies beyond that end: such a point has no counterpart in
+/// the reference (the edge of the range, an occlusion), and pairing it with the end would pull
+/// the scan back along the surface, a bias that builds up along a corridor.
+std::optional<SegmentProjection> project_onto_neighbour_segments(const Scan2D& reference,
+                                                                 std::size_t j, const Vec2& p,
+                                                                 double max_length) {
+  const Vec2& q = reference.points[j];
+  SegmentProjection best{q, Vec2::Zero()};
+  double best_squared = (p - q).squaredNorm();
+  int segments = 0;
+  bool beyond = false;
+  for (const long step : {-1L, 1L}) {
+    const long k = beam_neighbour(reference, j, step);
+    if (k < 0) continue;
+    const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
+    const double length_squared = d.squaredNorm();
+    if (length_squared < 1e-18 || length_squared > max_length * max_length) continue;
+    ++segments;
+    const double along = (p - q).dot(d) / length_squared;
+    beyond = along < 0.0;
+    const Vec2 candidate = q + std::clamp(along, 0.0, 1.0) * d;
+    const double squared = (p - candidate).squaredNorm();
+    // The first usable segment always counts (its nearest point is never farther than j).
+    if (squared < best_squared || best.normal.isZero()) {
+      best_squared = squared;
+      best = {candidate, Vec2(-d.y(), d.x()) / std::sqrt(length_squared)};
+    }
+  }
+  if (segments == 1 && beyond) return std::nullopt;
+  return best;
+}
+
+}  // namespace
+
+Pose2 coarse_alignment_2d(const std::vector<Vec2>& current, const std::vector<Vec2>& reference,
+                          double bin_width, double max_rotation, bool rotation, bool translation,
+                          double min_segment) {
+  Pose2 correction = Pose2::Identity();
+  if (rotation) {
+    const double angle =
+        histogram_rotation(angle_histogram(current, bin_width, 0.5, min_segment),
+                           angle_histogram(reference, bin_width, 0.5, min_segment), max_rotation);
+    correction.linear() = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  }
+  if (translation)
+    correction.translation() =
+        planar::centroid(reference) - correction.linear() * planar::centroid(current);
+  return correction;
+}
+
+// The sparse-icp line of the method table (registration2d.cpp).
+Registration2DResult run_sparse_icp(const Scan2D& current, const Scan2D& reference,
+                                    const Registration2DOptions& o, const Pose2& initial) {
+  // The correlative search, when it ran, replaces the coarse stage.
+  const bool coarse = !(o.search_window > 0.0);
+  Registration2DResult r;
+  r.transform = initial;
+  if (coarse && (o.coarse_rotation || o.coarse_translation))
+    r.transform =
+        coarse_alignment_2d(planar::transformed(current.points, initial), reference.points,
+                            o.histogram_bin, o.histogram_max_rotation, o.coarse_rotation,
+                            o.coarse_translation, o.histogram_min_segment) *
+        initial;
+  planar::PointPairs pairs;
+  std::vector<planar::LinePair> line_pairs;
+  const bool point_to_line = o.sparse_step == "point-to-line";
+  PathTracer path_tracer(reference.points, reference.circular, o.max_correspondence_distance,
+                         o.path_rules);
+  std::vector<FittedLine> lines;
+  if (point_to_line && o.sparse_line_radius > 0.0)
+    lines = fit_scan_lines(reference, o.sparse_line_radius, o.max_correspondence_distance);
+  for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
+    const std::vector<Vec2> moved = planar::transformed(current.points, r.transform);
+    const CorrespondencePath path = path_tracer.trace(moved);
+    pairs.clear();
+    line_pairs.clear();
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+      if (!path.valid[i]) continue;
+      const std::size_t j = static_cast<std::size_t>(path.row[i]);
+      if (point_to_line) {
+        if (!lines.empty() && !lines[j].normal.isZero()) {
+          const FittedLine& line = lines[j];
+          // Beyond the end of the surface (see project_onto_neighbour_segments), or beyond the
+          // stretch the line was fitted to (a run of current points on one reference point can
+          // reach far along it): no pair.
+          const Vec2 offset = moved[i] - line.point;
+          if ((moved[i] - reference.points[j]).dot(line.inward) < 0.0 ||
+              std::abs(offset.x() * line.normal.y() - offset.y() * line.normal.x()) >
+                  o.sparse_line_radius)
+            continue;
+          line_pairs.push_back({current.points[i], line.point, line.normal,
+                                std::abs(line.normal.dot(moved[i] - line.point))});
+          continue;
+        }
+        const auto projected =
+            project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
+        if (!projected || projected->normal.isZero()) continue;
+        const Vec2& n = projected->normal;
+        line_pairs.push_back({current.points[i], reference.points[j], n,
+                              std::abs(n.dot(moved[i] - reference.points[j]))});
+        continue;
+      }
+      Vec2 q = reference.points[j];
+      if (o.subsample_projection) {
+        const auto projected =
+            project_onto_neighbour_segments(reference, j, moved[i], o.max_correspondence_distance);
+        if (!projected) continue;
+        q = projected->point;
+      }
+      pairs.from.push_back(current.points[i]);
+      pairs.to.push_back(q);
+      pairs.distance_sum += (moved[i] - q).norm();
+    }
+    // Too few pairs left: the path no longer follows a surface both scans saw, and steps taken
+    // on what is left wander off (up to 170 deg on FHW from a poor start). Stop where we are.
+    const std::size_t kept = point_to_line ? line_pairs.size() : pairs.from.size();
+    if (static_cast<double>(kept) < std::max(3.0, o.sparse_min_pairs * moved.size())) {
+      r.pairs = kept;
+      break;
+    }
+    Pose2 next;
+    if (point_to_line) {
+      if (o.sparse_keep_fraction < 1.0)
+        planar::keep_nearest_fraction(line_pairs, o.sparse_keep_fraction);
+      r.pairs = line_pairs.size();
+      next = planar::solve_line_pairs(line_pairs, r.transform, r.error);
+    } else {
+      r.pairs = pairs.from.size();
+      next = align_svd(pairs.from, pairs.to);
+      r.error = pairs.distance_sum / static_cast<double>(r.pairs);
+    }
+    const Pose2 step = next * r.transform.inverse();
+    r.transform = next;
+    if (planar::small_step(step, std::max(o.tolerance, o.sparse_tolerance))) {
+      r.converged = true;
+      break;
+    }
+  }
+  r.iterations = std::min(r.iterations, o.max_iterations);
+  return r;
+}
+
+}  // namespace scanmatch
