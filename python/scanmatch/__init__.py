@@ -47,6 +47,11 @@ from . import eval  # noqa: A004  (scanmatch.eval, as the CLI's `scanmatch eval`
 
 __version__ = _scanmatch.__version__
 
+# Shown as scanmatch.X in messages and reprs (they live in the compiled scanmatch._scanmatch).
+for _cls in (Error, Odometry, PointCloud, RegistrationResult, Simulator):
+    _cls.__module__ = __name__
+del _cls
+
 __all__ = [
     "Error",
     "Odometry",
