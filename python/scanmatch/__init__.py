@@ -31,14 +31,20 @@ import numpy as np
 from . import _scanmatch
 from ._scanmatch import (
     Error,
+    Mapper2D,
     Odometry,
     PointCloud,
+    Registration2DResult,
     RegistrationResult,
     Simulator,
+    mapper2d_options,
     odometry_options,
     presets,
     read_cloud,
     register,
+    register2d,
+    registration_2d_methods,
+    registration_2d_options,
     registration_methods,
     registration_options,
     write_cloud,
@@ -48,23 +54,30 @@ from . import eval  # noqa: A004  (scanmatch.eval, as the CLI's `scanmatch eval`
 __version__ = _scanmatch.__version__
 
 # Shown as scanmatch.X in messages and reprs (they live in the compiled scanmatch._scanmatch).
-for _cls in (Error, Odometry, PointCloud, RegistrationResult, Simulator):
+for _cls in (Error, Mapper2D, Odometry, PointCloud, Registration2DResult, RegistrationResult,
+             Simulator):
     _cls.__module__ = __name__
 del _cls
 
 __all__ = [
     "Error",
+    "Mapper2D",
     "Odometry",
     "PointCloud",
+    "Registration2DResult",
     "RegistrationResult",
     "Simulation",
     "Simulator",
     "eval",
+    "mapper2d_options",
     "odometry_methods",
     "odometry_options",
     "presets",
     "read_cloud",
     "register",
+    "register2d",
+    "registration_2d_methods",
+    "registration_2d_options",
     "registration_methods",
     "registration_options",
     "simulate",

@@ -46,6 +46,11 @@ void FieldTable::assign(const std::string& path, int& field, py::handle value) c
   field = static_cast<int>(v);
 }
 
+void FieldTable::assign(const std::string& path, long& field, py::handle value) const {
+  if (!is_integer(value)) wrong_type(path, "an integer", value);
+  field = static_cast<long>(value.cast<long long>());
+}
+
 void FieldTable::assign(const std::string& path, std::uint32_t& field, py::handle value) const {
   if (!is_integer(value)) wrong_type(path, "a non-negative integer", value);
   const long long v = value.cast<long long>();

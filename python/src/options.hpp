@@ -77,6 +77,7 @@ class FieldTable {
   // One per field type of the descriptions.
   void assign(const std::string& path, double& field, py::handle value) const;
   void assign(const std::string& path, int& field, py::handle value) const;
+  void assign(const std::string& path, long& field, py::handle value) const;
   void assign(const std::string& path, std::uint32_t& field, py::handle value) const;
   void assign(const std::string& path, bool& field, py::handle value) const;
   void assign(const std::string& path, std::string& field, py::handle value) const;
