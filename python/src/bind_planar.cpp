@@ -1,0 +1,291 @@
+// 2D scan matching: register2d (registration/scan2d.hpp) and Mapper2D (odometry/mapper2d.hpp).
+// Scans are (N, 2) arrays of x y in the laser frame, in beam order (copied once into the
+// library's Scan2D); poses are 3x3 homogeneous float64 matrices (copies).
+
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+#include "options.hpp"
+#include "planar_fields.hpp"
+#include "scanmatch/odometry/mapper2d.hpp"
+#include "scanmatch/registration/scan2d.hpp"
+#include "scanmatch/sim/simulator.hpp"
+
+namespace scanmatch::python {
+namespace {
+
+Scan2D scan_from_arrays(py::handle points, py::handle times, bool circular,
+                        const std::string& name) {
+  const auto a = as_matrix(points, name, 2);
+  Scan2D scan;
+  scan.circular = circular;
+  scan.points.resize(static_cast<std::size_t>(a.shape(0)));
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    scan.points[i] =
+        Eigen::Vector2d(a.at(static_cast<py::ssize_t>(i), 0), a.at(static_cast<py::ssize_t>(i), 1));
+    if (!scan.points[i].allFinite())
+      throw py::value_error(name + ": point " + std::to_string(i) + " has a non-finite coordinate");
+  }
+  if (!times.is_none()) {
+    const auto t = as_vector(times, "times", a.shape(0));
+    scan.times.assign(t.data(), t.data() + scan.points.size());
+    for (std::size_t i = 0; i < scan.times.size(); ++i)
+      if (!std::isfinite(scan.times[i]))
+        throw py::value_error("times: entry " + std::to_string(i) + " is not finite");
+  }
+  return scan;
+}
+
+// A 3x3 homogeneous matrix or (x, y, theta); None: the identity.
+Pose2 pose2_from(py::handle obj, const std::string& name) {
+  if (obj.is_none()) return Pose2::Identity();
+  const py::array a = py::array::ensure(obj);
+  const bool vector = a && a.ndim() == 1 && a.shape(0) == 3;
+  const bool matrix = a && a.ndim() == 2 && a.shape(0) == 3 && a.shape(1) == 3;
+  if (!vector && !matrix) throw py::value_error(name + ": expected a 3x3 matrix or (x, y, theta)");
+  if (vector) {
+    const auto v = as_vector(obj, name, 3);
+    const Eigen::Vector3d xyt(v.at(0), v.at(1), v.at(2));
+    if (!xyt.allFinite()) throw py::value_error(name + ": (x, y, theta) must be finite");
+    return pose2(xyt);
+  }
+  const auto m = as_matrix(obj, name, 3);
+  Eigen::Matrix3d M;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) M(r, c) = m.at(r, c);
+  if (!M.allFinite()) throw py::value_error(name + ": the transform has non-finite entries");
+  if ((M.row(2) - Eigen::RowVector3d(0, 0, 1)).norm() > 1e-9)
+    throw py::value_error(name + ": the last row of a 3x3 transform must be 0 0 1");
+  const Eigen::Matrix2d R = M.topLeftCorner<2, 2>();
+  if ((R.transpose() * R - Eigen::Matrix2d::Identity()).norm() > 1e-4 || R.determinant() < 0)
+    throw py::value_error(name + ": the rotation block is not a rotation matrix");
+  return pose2(M(0, 2), M(1, 2), std::atan2(M(1, 0), M(0, 0)));
+}
+
+py::array_t<double> pose2_to_array(const Pose2& T) {
+  py::array_t<double> out({3, 3});
+  auto o = out.mutable_unchecked<2>();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) o(r, c) = T.matrix()(r, c);
+  return out;
+}
+
+struct PyRegistration2DResult {
+  Registration2DResult result;
+  std::string method;
+};
+
+class PyMapper2D {
+ public:
+  explicit PyMapper2D(const Mapper2DConfig& config) : mapper_(config), config_(config) {}
+
+  py::array_t<double> add_scan(py::handle points, py::handle times, std::optional<double> timestamp,
+                               bool circular) {
+    const Scan2D scan = scan_from_arrays(points, times, circular, "points");
+    double stamp = timestamps_.empty() ? 0.0 : timestamps_.back() + 0.2;
+    if (timestamp) {
+      stamp = *timestamp;
+      if (!std::isfinite(stamp)) throw py::value_error("timestamp must be finite");
+    }
+    Pose2 pose;
+    {
+      py::gil_scoped_release release;
+      pose = mapper_.add_scan(scan, stamp);
+    }
+    poses_.push_back(pose);
+    timestamps_.push_back(stamp);
+    stats_.push_back(mapper_.last_stats());
+    return pose2_to_array(pose);
+  }
+
+  const std::vector<Pose2>& poses() const { return poses_; }
+  const std::vector<double>& timestamps() const { return timestamps_; }
+  const std::vector<Scan2DStats>& stats() const { return stats_; }
+  const Mapper2DConfig& config() const { return config_; }
+
+ private:
+  Mapper2D mapper_;
+  Mapper2DConfig config_;
+  std::vector<Pose2> poses_;
+  std::vector<double> timestamps_;
+  std::vector<Scan2DStats> stats_;
+};
+
+py::dict stats_dict(const Scan2DStats& s) {
+  py::dict d;
+  d["ms"] = s.ms;
+  d["iterations"] = s.iterations;
+  d["points"] = s.points;
+  d["pairs"] = s.pairs;
+  d["error"] = s.error;
+  d["bridged"] = s.bridged;
+  return d;
+}
+
+}  // namespace
+
+void bind_planar(py::module_& m) {
+  using R = PyRegistration2DResult;
+  py::class_<R>(m, "Registration2DResult", "What register2d() found (3x3 float64 copies).")
+      .def_property_readonly(
+          "transform", [](const R& r) { return pose2_to_array(r.result.transform); },
+          "3x3: maps current-scan points into the reference frame")
+      .def_property_readonly("x", [](const R& r) { return r.result.transform.translation().x(); })
+      .def_property_readonly("y", [](const R& r) { return r.result.transform.translation().y(); })
+      .def_property_readonly(
+          "theta", [](const R& r) { return pose2_angle(r.result.transform); }, "rad")
+      .def_readonly("method", &R::method)
+      .def_property_readonly("iterations", [](const R& r) { return r.result.iterations; })
+      .def_property_readonly("converged", [](const R& r) { return r.result.converged; })
+      .def_property_readonly(
+          "error", [](const R& r) { return r.result.error; },
+          "mean distance of the final correspondences, m")
+      .def_property_readonly("pairs", [](const R& r) { return r.result.pairs; })
+      .def("__repr__", [](const R& r) {
+        const Pose2& T = r.result.transform;
+        return "<scanmatch.Registration2DResult " + r.method + ": x " +
+               std::to_string(T.translation().x()) + " y " + std::to_string(T.translation().y()) +
+               " theta " + std::to_string(pose2_angle(T)) + ", " +
+               std::to_string(r.result.iterations) + " iterations" +
+               (r.result.converged ? ", converged>" : ">");
+      });
+
+  m.def(
+      "register2d",
+      [](py::handle current, py::handle reference, const std::string& method, py::handle initial,
+         bool circular, py::kwargs kwargs) {
+        Registration2DOptions options;
+        options.method = method;
+        FieldTable table(options, "register2d()");
+        table.apply(kwargs);
+        check_registration_2d_method(method);
+        const Scan2D c = scan_from_arrays(current, py::none(), circular, "current");
+        const Scan2D r = scan_from_arrays(reference, py::none(), circular, "reference");
+        const Pose2 guess = pose2_from(initial, "initial");
+        R out;
+        out.method = method;
+        {
+          py::gil_scoped_release release;
+          out.result = register_scans(c, r, options, guess);
+        }
+        return out;
+      },
+      py::arg("current"), py::arg("reference"), py::arg("method") = "sparse-icp",
+      py::arg("initial") = py::none(), py::arg("circular") = false, R"doc(
+register2d(current, reference, method="sparse-icp", initial=None, circular=False, **options)
+
+Registers a 2D laser scan onto another: both (N, 2) arrays of x y in the laser frame, in beam
+order (copied once). circular: the scans cover 360 degrees (the last beam neighbours the first).
+initial: a 3x3 transform or (x, y, theta) (None: identity). Methods: registration_2d_methods().
+Options are the fields of Registration2DOptions by name (registration_2d_options() lists them),
+e.g. max_correspondence_distance=0.3, search_window=1.0, path_rules={"max_step": 1}. Returns a
+Registration2DResult whose transform maps current points into the reference frame.)doc");
+
+  m.def("registration_2d_methods", &registration_2d_method_names, "the 2D registration methods");
+  m.def(
+      "registration_2d_options",
+      [](bool help) {
+        Registration2DOptions options;
+        FieldTable table(options, "registration_2d_options()");
+        return help ? table.help() : table.values();
+      },
+      py::arg("help") = false, "Every keyword option of register2d as {dotted key: default}");
+
+  py::class_<PyMapper2D>(m, "Mapper2D", R"doc(
+Mapper2D(method="sparse-icp", **config): 2D scan-to-scan mapping; each scan is registered onto
+the previous one (or the last keyframe) and the results are chained. config: the fields of
+Mapper2DConfig (constant_velocity, min_range, max_correction, keyframe_distance, deskew, ...)
+and of its registration options, flat (max_iterations=20) or as registration={...};
+mapper2d_options() lists them.)doc")
+      .def(py::init([](const std::string& method, py::kwargs kwargs) {
+             Mapper2DConfig config;
+             config.registration.method = method;
+             FieldTable table(config, "Mapper2D()");
+             table.apply(kwargs);
+             return std::make_unique<PyMapper2D>(config);
+           }),
+           py::arg("method") = "sparse-icp")
+      .def("add_scan", &PyMapper2D::add_scan, py::arg("points"), py::arg("times") = py::none(),
+           py::arg("timestamp") = py::none(), py::arg("circular") = false, R"doc(
+add_scan(points, times=None, timestamp=None, circular=False) -> 3x3 pose
+
+Registers the next scan ((N, 2) x y in beam order, copied once; times: (N,) s after the first
+beam, for deskew=True; timestamp: s, None: 0.2 s after the previous scan) and returns the
+laser's pose in the frame of the first scan. Scans too small to register are bridged by the
+motion prior (last_stats["bridged"]).)doc")
+      .def_property_readonly(
+          "poses",
+          [](const PyMapper2D& p) {
+            py::array_t<double> out(
+                {static_cast<py::ssize_t>(p.poses().size()), py::ssize_t{3}, py::ssize_t{3}});
+            auto o = out.mutable_unchecked<3>();
+            for (std::size_t i = 0; i < p.poses().size(); ++i)
+              for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c)
+                  o(static_cast<py::ssize_t>(i), r, c) = p.poses()[i].matrix()(r, c);
+            return out;
+          },
+          "(N, 3, 3) float64 copy of every pose returned so far")
+      .def_property_readonly("last_stats",
+                             [](const PyMapper2D& p) -> py::object {
+                               if (p.stats().empty()) return py::none();
+                               return stats_dict(p.stats().back());
+                             })
+      .def_property_readonly("stats",
+                             [](const PyMapper2D& p) {
+                               py::list out;
+                               for (const auto& s : p.stats()) out.append(stats_dict(s));
+                               return out;
+                             })
+      .def_property_readonly("config",
+                             [](const PyMapper2D& p) {
+                               Mapper2DConfig config = p.config();
+                               FieldTable table(config, "Mapper2D.config");
+                               py::dict d = table.values();
+                               d["registration.method"] = config.registration.method;
+                               return d;
+                             })
+      .def("__len__", [](const PyMapper2D& p) { return p.poses().size(); });
+
+  m.def(
+      "mapper2d_options",
+      [](bool help) {
+        Mapper2DConfig config;
+        FieldTable table(config, "mapper2d_options()");
+        return help ? table.help() : table.values();
+      },
+      py::arg("help") = false, "Every keyword option of Mapper2D as {dotted key: default}");
+
+  // 2D presets of the simulator: scans as the mappers take them.
+  py::reinterpret_borrow<py::class_<sim::Simulator>>(m.attr("Simulator"))
+      .def(
+          "scan2d",
+          [](const sim::Simulator& s, std::size_t i) {
+            if (!s.sensor().is_2d())
+              throw py::value_error("scan2d: the sensor " + s.sensor().name + " is not a 2D laser");
+            if (i >= s.size())
+              throw py::index_error("scan " + std::to_string(i) + " of " +
+                                    std::to_string(s.size()));
+            Scan2D scan;
+            {
+              py::gil_scoped_release release;
+              scan = scan_from_laser(s.scan_2d(i));
+            }
+            py::array_t<double> points(
+                {static_cast<py::ssize_t>(scan.points.size()), py::ssize_t{2}});
+            auto o = points.mutable_unchecked<2>();
+            for (std::size_t k = 0; k < scan.points.size(); ++k) {
+              o(static_cast<py::ssize_t>(k), 0) = scan.points[k].x();
+              o(static_cast<py::ssize_t>(k), 1) = scan.points[k].y();
+            }
+            return py::make_tuple(points, scan.circular);
+          },
+          py::arg("index"),
+          "Scan i of a 2D preset (room-2d): ((N, 2) x y in beam order, circular), as "
+          "register2d and Mapper2D take them");
+}
+
+}  // namespace scanmatch::python

@@ -1,0 +1,142 @@
+#include "convert.hpp"
+
+#include <cmath>
+#include <cstring>
+
+#include "scanmatch/core/point_cloud.hpp"
+
+namespace scanmatch::python {
+namespace {
+
+std::string shape_of(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) {
+    if (i > 0) s += ", ";
+    s += std::to_string(a.shape(i));
+  }
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+// Any array-like as a numpy array of a real (bool excluded) dtype.
+py::array numeric_array(py::handle obj, const std::string& name) {
+  if (obj.is_none()) throw py::type_error(name + ": expected an array, got None");
+  py::array a;
+  try {
+    a = py::array::ensure(obj);
+  } catch (const py::error_already_set&) {
+  }
+  if (!a) throw py::type_error(name + ": expected a numeric array");
+  const char kind = a.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::type_error(name + ": expected a real-valued (float or integer) array, got dtype " +
+                         py::str(a.dtype()).cast<std::string>());
+  return a;
+}
+
+}  // namespace
+
+py::array_t<double, py::array::c_style | py::array::forcecast> as_matrix(py::handle obj,
+                                                                         const std::string& name,
+                                                                         py::ssize_t columns) {
+  const py::array a = numeric_array(obj, name);
+  if (a.ndim() != 2 || a.shape(1) != columns)
+    throw py::value_error(name + ": expected an array of shape (N, " + std::to_string(columns) +
+                          "), got " + shape_of(a));
+  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
+py::array_t<double, py::array::c_style | py::array::forcecast> as_vector(py::handle obj,
+                                                                         const std::string& name,
+                                                                         py::ssize_t n) {
+  const py::array a = numeric_array(obj, name);
+  if (a.ndim() != 1 || a.shape(0) != n)
+    throw py::value_error(name + ": expected an array of shape (" + std::to_string(n) + ",), got " +
+                          shape_of(a));
+  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
+void check_finite(const PointCloud& cloud, const std::string& name) {
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Point& p = cloud.points[i];
+    if (!p.allFinite())
+      throw py::value_error(name + ": point " + std::to_string(i) +
+                            " has a non-finite coordinate (" + std::to_string(p.x()) + ", " +
+                            std::to_string(p.y()) + ", " + std::to_string(p.z()) + ")");
+  }
+}
+
+PointCloud cloud_from_array(py::handle obj, const std::string& name, bool finite) {
+  const py::array a = numeric_array(obj, name);
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw py::value_error(name + ": expected an array of shape (N, 3) with x y z, got " +
+                          shape_of(a));
+  // float32 C-contiguous input is not copied here; other dtypes and layouts are converted.
+  const auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
+  PointCloud cloud;
+  cloud.points.resize(static_cast<std::size_t>(f.shape(0)));
+  static_assert(sizeof(Point) == 3 * sizeof(float), "Point must be three packed floats");
+  if (!cloud.points.empty())
+    std::memcpy(cloud.points.front().data(), f.data(), cloud.points.size() * sizeof(Point));
+  if (finite) check_finite(cloud, name);
+  return cloud;
+}
+
+const PointCloud& cloud_argument(py::handle obj, const std::string& name,
+                                 std::optional<PointCloud>& storage) {
+  if (py::isinstance<PointCloud>(obj)) {
+    const PointCloud& cloud = obj.cast<const PointCloud&>();
+    check_finite(cloud, name);
+    return cloud;
+  }
+  storage = cloud_from_array(obj, name);
+  return *storage;
+}
+
+Pose pose_from_array(py::handle obj, const std::string& name) {
+  if (obj.is_none()) return Pose::Identity();
+  const py::array a = numeric_array(obj, name);
+  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4)
+    throw py::value_error(name + ": expected a 4x4 transform, got shape " + shape_of(a));
+  const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = d.at(r, c);
+  if (!m.allFinite()) throw py::value_error(name + ": the transform has non-finite entries");
+  if ((m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9)
+    throw py::value_error(name + ": the last row of a 4x4 transform must be 0 0 0 1");
+  const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-4 || R.determinant() < 0)
+    throw py::value_error(name + ": the rotation block is not a rotation matrix");
+  return from_matrix(m);
+}
+
+py::array_t<double> pose_to_array(const Pose& pose) {
+  py::array_t<double> out({4, 4});
+  auto o = out.mutable_unchecked<2>();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) o(r, c) = pose.matrix()(r, c);
+  return out;
+}
+
+std::vector<Pose> poses_from_array(py::handle obj, const std::string& name) {
+  const py::array a = numeric_array(obj, name);
+  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
+    throw py::value_error(name + ": expected an array of shape (N, 4, 4), got " + shape_of(a));
+  std::vector<Pose> poses;
+  poses.reserve(static_cast<std::size_t>(a.shape(0)));
+  py::object sequence = py::reinterpret_borrow<py::object>(a);
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    poses.push_back(pose_from_array(sequence[py::int_(i)], name + "[" + std::to_string(i) + "]"));
+  return poses;
+}
+
+py::array_t<double> poses_to_array(const std::vector<Pose>& poses) {
+  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
+  auto o = out.mutable_unchecked<3>();
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) o(static_cast<py::ssize_t>(i), r, c) = poses[i].matrix()(r, c);
+  return out;
+}
+
+}  // namespace scanmatch::python
