@@ -10,8 +10,11 @@
 #include "convert.hpp"
 #include "options.hpp"
 #include "planar_fields.hpp"
+#include "scanmatch/core/scan2d.hpp"
+#include "scanmatch/io/carmen.hpp"
 #include "scanmatch/odometry/mapper2d.hpp"
-#include "scanmatch/registration/scan2d.hpp"
+#include "scanmatch/registration/planar/correspondence_path.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch::python {
