@@ -16,10 +16,10 @@ struct ConfigOptionAdder {
     if (!flag) return;
     if constexpr (std::is_same_v<T, bool>) {
       cmd->add_flag(flag, field, help);
-    } else if constexpr (std::is_same_v<T, KernelType>) {
+    } else if constexpr (std::is_enum_v<T>) {
       cmd->add_option_function<std::string>(
-             flag, [&field](const std::string& name) { field = parse_kernel(name); }, help)
-          ->default_str(kernel_name(field));
+             flag, [&field](const std::string& name) { enum_from_name(name, field); }, help)
+          ->default_str(enum_name(field));
     } else {
       cmd->add_option(flag, field, help)->capture_default_str();
     }

@@ -2,11 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/io/file_util.hpp"
 #include "scanmatch/odometry/config_fields.hpp"
 #include "scanmatch/odometry/config_io.hpp"
+#include "test_helpers.hpp"
 
 namespace scanmatch {
 namespace {
@@ -23,10 +26,20 @@ struct FlagCollector {
   }
 };
 
-TEST(ConfigDescription, FlagsAreUniqueAndSpelledLikeOptions) {
-  OdometryConfig config;
+template <typename Config>
+std::vector<std::string> flags_of() {
+  Config config;
   FlagCollector collector;
   describe(config, collector);
+  return collector.flags;
+}
+
+TEST(ConfigDescription, FlagsAreUniqueAndSpelledLikeOptions) {
+  for (const auto& flag : flags_of<Map2DRunOptions>()) EXPECT_EQ(flag.rfind("--", 0), 0u) << flag;
+  const auto map2d = flags_of<Map2DRunOptions>();
+  EXPECT_EQ(std::set<std::string>(map2d.begin(), map2d.end()).size(), map2d.size());
+  FlagCollector collector;
+  collector.flags = flags_of<OdometryConfig>();
   std::set<std::string> seen;
   for (const auto& flag : collector.flags) {
     EXPECT_TRUE(seen.insert(flag).second) << flag << " is described twice";
@@ -88,6 +101,36 @@ TEST(ConfigDescription, UnknownKeysAndBadKernelsNameTheKey) {
     EXPECT_NE(std::string(e.what()).find("registration.solver.kernel"), std::string::npos)
         << e.what();
   }
+}
+
+TEST(ConfigDescription, Map2DRunsReloadWithConfigAndGivenFlagsWin) {
+  testing::TempDir dir;
+  const std::string first = dir.file("first"), again = dir.file("again"), other = dir.file("other");
+  const std::string common = "map2d sim:room-2d --scans 30 --quiet ";
+  ASSERT_EQ(testing::run_cli(common + "--method pl-icp --search-angle 30 --out " + first).status,
+            0);
+  const Map2DRunOptions written = read_map2d_config(first + "/config.json");
+  EXPECT_EQ(written.mapper.registration.method, "pl-icp");
+  EXPECT_NEAR(written.mapper.registration.search_angle, 30 * M_PI / 180, 1e-12);
+  EXPECT_DOUBLE_EQ(written.mapper.registration.search_window, 1.3);  // the command's default
+
+  // The same configuration again gives the same poses; a flag given on top wins over the file.
+  ASSERT_EQ(testing::run_cli(common + "--config " + first + "/config.json --out " + again).status,
+            0);
+  EXPECT_EQ(read_file_bytes(first + "/poses_tum.txt"), read_file_bytes(again + "/poses_tum.txt"));
+  ASSERT_EQ(
+      testing::run_cli(common + "--config " + first + "/config.json --method icp --out " + other)
+          .status,
+      0);
+  const Map2DRunOptions overridden = read_map2d_config(other + "/config.json");
+  EXPECT_EQ(overridden.mapper.registration.method, "icp");
+  EXPECT_NEAR(overridden.mapper.registration.search_angle, 30 * M_PI / 180, 1e-12);
+
+  testing::write_text(dir.file("bad.json"), R"({"mapper": {"registration": {"metod": "icp"}}})");
+  const auto bad =
+      testing::run_cli(common + "--config " + dir.file("bad.json") + " --out " + other);
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("mapper.registration.metod"), std::string::npos) << bad.output;
 }
 
 }  // namespace

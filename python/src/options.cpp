@@ -70,16 +70,6 @@ void FieldTable::assign(const std::string& path, std::string& field, py::handle 
   field = value.cast<std::string>();
 }
 
-void FieldTable::assign(const std::string& path, KernelType& field, py::handle value) const {
-  if (!py::isinstance<py::str>(value))
-    wrong_type(path, "a kernel name (none, huber, cauchy, tukey, geman-mcclure)", value);
-  try {
-    field = parse_kernel(value.cast<std::string>());
-  } catch (const Error& e) {
-    throw py::value_error(function_ + ": option '" + path + "': " + e.what());
-  }
-}
-
 std::string FieldTable::valid_keys() const {
   std::string list;
   for (const auto& [leaf, paths] : leaves_) {

@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "scanmatch/core/error.hpp"
 #include "scanmatch/odometry/config_fields.hpp"
 
 namespace scanmatch::python {
@@ -68,8 +69,8 @@ class FieldTable {
 
   template <typename T>
   static py::object get(const T& field) {
-    if constexpr (std::is_same_v<T, KernelType>)
-      return py::str(kernel_name(field));
+    if constexpr (std::is_enum_v<T>)
+      return py::str(enum_name(field));
     else
       return py::cast(field);
   }
@@ -81,7 +82,16 @@ class FieldTable {
   void assign(const std::string& path, std::uint32_t& field, py::handle value) const;
   void assign(const std::string& path, bool& field, py::handle value) const;
   void assign(const std::string& path, std::string& field, py::handle value) const;
-  void assign(const std::string& path, KernelType& field, py::handle value) const;
+  /// Enumerations by name (enum_name / enum_from_name of config_fields.hpp).
+  template <typename E, typename = std::enable_if_t<std::is_enum_v<E>>>
+  void assign(const std::string& path, E& field, py::handle value) const {
+    if (!py::isinstance<py::str>(value)) wrong_type(path, "a name", value);
+    try {
+      enum_from_name(value.cast<std::string>(), field);
+    } catch (const Error& e) {
+      throw py::value_error(function_ + ": option '" + path + "': " + e.what());
+    }
+  }
   [[noreturn]] void wrong_type(const std::string& path, const char* expected,
                                py::handle value) const;
   std::string valid_keys() const;

@@ -8,11 +8,26 @@
 //   template <class T> void operator()(const char* key, T& field, const char* flag,
 //                                      const char* help);   // flag nullptr: JSON only
 //   template <class S> void nested(const char* key, S& options);  // a nested object
-// and describe(options, visitor) calls it for every field.
+// and describe(options, visitor) calls it for every field. Enumerations are named (enum_name,
+// enum_from_name); angles are radians in JSON and Python (the CLI may offer degrees).
 
 #include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/run2d.hpp"
 
 namespace scanmatch {
+
+inline const char* enum_name(KernelType type) {
+  return kernel_name(type);
+}
+inline void enum_from_name(const std::string& name, KernelType& type) {
+  type = parse_kernel(name);
+}
+inline const char* enum_name(PathRules::Shared shared) {
+  return to_string(shared);
+}
+inline void enum_from_name(const std::string& name, PathRules::Shared& shared) {
+  shared = parse_shared_rows(name);
+}
 
 template <typename Visitor>
 void describe(SolverOptions& s, Visitor& v) {
@@ -96,6 +111,88 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("max_jump_angle", c.max_jump_angle, nullptr, "likewise for rotation, rad");
   v("threads", c.threads, "--threads", "Threads (1 for fair comparisons)");
   v.nested("registration", c.registration);
+}
+
+// 2D: map2d's run (Map2DRunOptions) and what it nests.
+
+template <typename Visitor>
+void describe(PathRules& p, Visitor& v) {
+  v("max_step", p.max_step, "--path-max-step",
+    "sparse-icp: reference rows a kept pair may skip (1: the paper)");
+  v("shared", p.shared, "--shared-rows",
+    "sparse-icp: points sharing a reference point: drop (the paper), keep-nearest or keep-all");
+  v("max_run", p.max_run, nullptr, "sparse-icp keep-all: longest run of points on one row");
+}
+
+template <typename Visitor>
+void describe(Registration2DOptions& r, Visitor& v) {
+  v("method", r.method, "--method", "A 2D registration method");
+  v("max_iterations", r.max_iterations, "--max-iterations", "Iteration limit of each registration");
+  v("tolerance", r.tolerance, nullptr, "m and rad: stop below this step");
+  v("max_correspondence_distance", r.max_correspondence_distance, "--max-distance",
+    "Correspondence distance: sparse-icp's Manhattan threshold D, the baselines' rejection, m");
+  v("histogram_bin", r.histogram_bin, nullptr, "sparse-icp: angle histogram bin, rad");
+  v("histogram_min_segment", r.histogram_min_segment, nullptr,
+    "sparse-icp: shortest histogram segment, m");
+  v("histogram_max_rotation", r.histogram_max_rotation, nullptr,
+    "sparse-icp: histogram rotation search window, rad");
+  v("coarse_rotation", r.coarse_rotation, nullptr, "sparse-icp: angle-histogram rotation");
+  v("coarse_translation", r.coarse_translation, "--centroid-translation",
+    "sparse-icp: the paper's centroid translation in the coarse stage");
+  v("subsample_projection", r.subsample_projection, nullptr,
+    "sparse-icp: project pairs onto the reference segments");
+  v("sparse_step", r.sparse_step, "--sparse-step",
+    "sparse-icp's step on the kept pairs: svd (the paper) or point-to-line");
+  v("sparse_tolerance", r.sparse_tolerance, nullptr, "sparse-icp's stop, m and rad");
+  v("sparse_keep_fraction", r.sparse_keep_fraction, nullptr, "sparse-icp: fraction of pairs kept");
+  v("sparse_min_pairs", r.sparse_min_pairs, nullptr,
+    "sparse-icp: stop below this fraction of paired points");
+  v("sparse_line_radius", r.sparse_line_radius, "--line-radius",
+    "sparse-icp: lines are fitted to the reference within this radius, m (0: the segment to the "
+    "next beam)");
+  v("pl_line_radius", r.pl_line_radius, nullptr, "pl-icp: line fit radius, m (0: Censi)");
+  v("normal_angle", r.normal_angle, nullptr, "normal-icp's rejection angle, rad");
+  v("keep_fraction", r.keep_fraction, nullptr, "pl-icp: fraction of pairs kept");
+  v("search_window", r.search_window, "--search-window",
+    "Correlative coarse search over +- this many m before matching (0: off)");
+  v("search_angle", r.search_angle, nullptr, "correlative search, +- rad");
+  v("search_resolution", r.search_resolution, nullptr, "correlative search grid, m");
+  v.nested("path_rules", r.path_rules);
+}
+
+template <typename Visitor>
+void describe(Mapper2DConfig& c, Visitor& v) {
+  v("constant_velocity", c.constant_velocity, nullptr, "previous motion as the initial guess");
+  v("min_range", c.min_range, nullptr, "m: nearer returns are dropped");
+  v("max_correction", c.max_correction, nullptr, "m: larger corrections are failed matches");
+  v("max_correction_angle", c.max_correction_angle, nullptr, "rad: likewise for rotation");
+  v("keyframe_distance", c.keyframe_distance, "--keyframe-distance",
+    "Match against the last keyframe, replaced after this many m (0: scan to scan)");
+  v("keyframe_angle", c.keyframe_angle, nullptr, "rad: likewise for rotation");
+  v("deskew", c.deskew, "--deskew",
+    "Deskew scans by the last step's motion (experimental: see docs/planar.md)");
+  v.nested("registration", c.registration);
+}
+
+template <typename Visitor>
+void describe(GridMapOptions& g, Visitor& v) {
+  v("resolution", g.resolution, "--grid-resolution", "Grid cell size, m");
+  v("hit_log_odds", g.hit_log_odds, nullptr, "log-odds added where a beam ends");
+  v("miss_log_odds", g.miss_log_odds, nullptr, "log-odds added where a beam passes");
+  v("min_log_odds", g.min_log_odds, nullptr, "lower clamp of a cell's log-odds");
+  v("max_log_odds", g.max_log_odds, nullptr, "upper clamp of a cell's log-odds");
+  v("occupied_threshold", g.occupied_threshold, nullptr, "probability of an occupied cell");
+  v("free_threshold", g.free_threshold, nullptr, "probability of a free cell");
+}
+
+template <typename Visitor>
+void describe(Map2DRunOptions& o, Visitor& v) {
+  v("miss_range", o.miss_range, "--miss-range",
+    "No-return beams free the grid out to this range, m (0: not at all)");
+  v("reference_map", o.reference_map, "--reference-map",
+    "Also build map_reference.* from the input's reference poses");
+  v.nested("mapper", o.mapper);
+  v.nested("grid", o.grid);
 }
 
 }  // namespace scanmatch

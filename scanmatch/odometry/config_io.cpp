@@ -17,8 +17,8 @@ struct ToJson {
   Json& j;
   template <typename T>
   void operator()(const char* key, T& field, const char*, const char*) {
-    if constexpr (std::is_same_v<T, KernelType>)
-      j[key] = kernel_name(field);
+    if constexpr (std::is_enum_v<T>)
+      j[key] = enum_name(field);
     else
       j[key] = field;
   }
@@ -71,9 +71,9 @@ struct FromJson {
     if (!j.contains(key)) return;
     const Json& value = j[key];
     try {
-      if constexpr (std::is_same_v<T, KernelType>) {
+      if constexpr (std::is_enum_v<T>) {
         if (!value.is_string()) throw std::invalid_argument("");
-        field = parse_kernel(value.get<std::string>());
+        enum_from_name(value.get<std::string>(), field);
         return;
       } else if constexpr (std::is_same_v<T, bool>) {
         if (!value.is_boolean()) throw std::invalid_argument("");
@@ -117,21 +117,43 @@ Json parse(const std::string& text, const std::string& source) {
   }
 }
 
-}  // namespace
-
-std::string odometry_config_to_json(const OdometryConfig& config) {
-  OdometryConfig c = config;
+template <typename Config>
+std::string config_to_json(const Config& config) {
+  Config c = config;
   Json j = Json::object();
   ToJson writer{j};
   describe(c, writer);
   return j.dump(2) + "\n";
 }
 
-OdometryConfig odometry_config_from_json(const std::string& text, const std::string& source,
-                                         const OdometryConfig& base) {
-  OdometryConfig c = base;
+template <typename Config>
+Config config_from_json(const std::string& text, const std::string& source, const Config& base) {
+  Config c = base;
   FromJson::read(parse(text, source), c, source, "");
   return c;
+}
+
+template <typename Config>
+Config config_override_given(const Config& base, const Config& given,
+                             const std::function<bool(const std::string&)>& was_given) {
+  Config g = given;
+  Json j = Json::object();
+  GivenToJson writer{j, was_given};
+  describe(g, writer);
+  Config c = base;
+  FromJson::read(j, c, "the command line", "");
+  return c;
+}
+
+}  // namespace
+
+std::string odometry_config_to_json(const OdometryConfig& config) {
+  return config_to_json(config);
+}
+
+OdometryConfig odometry_config_from_json(const std::string& text, const std::string& source,
+                                         const OdometryConfig& base) {
+  return config_from_json(text, source, base);
 }
 
 OdometryConfig read_odometry_config(const std::string& path, const OdometryConfig& base) {
@@ -140,13 +162,20 @@ OdometryConfig read_odometry_config(const std::string& path, const OdometryConfi
 
 OdometryConfig override_given_flags(const OdometryConfig& base, const OdometryConfig& given,
                                     const std::function<bool(const std::string&)>& was_given) {
-  OdometryConfig g = given;
-  Json j = Json::object();
-  GivenToJson writer{j, was_given};
-  describe(g, writer);
-  OdometryConfig c = base;
-  FromJson::read(j, c, "the command line", "");
-  return c;
+  return config_override_given(base, given, was_given);
+}
+
+std::string map2d_config_to_json(const Map2DRunOptions& options) {
+  return config_to_json(options);
+}
+
+Map2DRunOptions read_map2d_config(const std::string& path, const Map2DRunOptions& base) {
+  return config_from_json(read_file_bytes(path), path, base);
+}
+
+Map2DRunOptions override_given_flags(const Map2DRunOptions& base, const Map2DRunOptions& given,
+                                     const std::function<bool(const std::string&)>& was_given) {
+  return config_override_given(base, given, was_given);
 }
 
 }  // namespace scanmatch

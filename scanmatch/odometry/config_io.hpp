@@ -1,5 +1,5 @@
 #pragma once
-// OdometryConfig as JSON, from the one description in config_fields.hpp: every run writes the
+// Configurations as JSON, from the one description in config_fields.hpp: every run writes the
 // configuration it used (RUNDIR/config.json) and `--config FILE` loads one back, so any number can
 // be reproduced. Keys are the field names, with "registration", "registration.solver" and
 // "registration.loam" nested. A file may give any subset; unknown keys and wrong types are errors
@@ -9,6 +9,7 @@
 #include <string>
 
 #include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/run2d.hpp"
 
 namespace scanmatch {
 
@@ -23,5 +24,12 @@ OdometryConfig read_odometry_config(const std::string& path, const OdometryConfi
 /// file overridden by exactly the options on the command line.
 OdometryConfig override_given_flags(const OdometryConfig& base, const OdometryConfig& given,
                                     const std::function<bool(const std::string& flag)>& was_given);
+
+/// map2d's configuration (Map2DRunOptions: mapper, registration, grid), the same way: map2d writes
+/// RUNDIR/config.json and `map2d --config FILE` loads it back. Angles are radians.
+std::string map2d_config_to_json(const Map2DRunOptions& options);
+Map2DRunOptions read_map2d_config(const std::string& path, const Map2DRunOptions& base = {});
+Map2DRunOptions override_given_flags(const Map2DRunOptions& base, const Map2DRunOptions& given,
+                                     const std::function<bool(const std::string&)>& was_given);
 
 }  // namespace scanmatch

@@ -10,6 +10,7 @@
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch {
@@ -188,6 +189,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   if (summary.one_step.pairs > 0) j["relative_error_1"] = error_json(summary.one_step);
   if (summary.ten_steps.pairs > 0) j["relative_error_10"] = error_json(summary.ten_steps);
   write_file_atomic(file("summary.json"), j.dump(2) + "\n");
+  write_file_atomic(file("config.json"), map2d_config_to_json(options));
   return summary;
 }
 

@@ -49,7 +49,8 @@ struct Map2DSummary {
 };
 
 /// Writes RUNDIR/poses_tum.txt and timing.csv (flushed per scan), poses_reference_tum.txt,
-/// summary.json and map.{pgm,yaml,png} (atomically).
+/// summary.json, config.json (the options, for `map2d --config`) and map.{pgm,yaml,png}
+/// (atomically).
 Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
                        const Map2DRunOptions& options);
 
