@@ -7,6 +7,7 @@
 // grows when a ray leaves it, so a cell keeps its world position for the life of the grid.
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -43,6 +44,11 @@ enum class CellState {
   kFree,      ///< probability below free_threshold
   kOccupied,  ///< probability above occupied_threshold
 };
+
+/// The probability a log-odds value stands for.
+inline double log_odds_to_probability(double log_odds) {
+  return 1.0 / (1.0 + std::exp(-log_odds));
+}
 
 /// Grey levels of the map_server "trinary" rendering.
 inline constexpr std::uint8_t kOccupiedPixel = 0;
