@@ -3,20 +3,13 @@
 
 #include <fmt/format.h>
 
-#include <atomic>
-#include <csignal>
-
 #include "apps/commands.hpp"
+#include "apps/interrupt.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/odometry/run2d.hpp"
 
 namespace scanmatch::cli {
 namespace {
-
-std::atomic<bool> interrupted{false};
-extern "C" void on_map2d_interrupt(int) {
-  interrupted.store(true);
-}
 
 struct Map2DCommand {
   std::string sequence, out, initial = "identity";
@@ -103,17 +96,12 @@ void add_map2d_command(CLI::App& app) {
     c->run.mapper.registration.path_rules.shared = parse_shared_rows(c->shared_rows);
     Scans2D input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
     if (c->rotation_period >= 0.0) input.rotation_period = c->rotation_period;
-    interrupted.store(false);
-    c->run.stop = &interrupted;
-    const auto previous = std::signal(SIGINT, on_map2d_interrupt);
     Map2DSummary s;
-    try {
+    {
+      const InterruptFlag interrupt;
+      c->run.stop = interrupt.flag();
       s = run_map2d(input, c->out, c->run);
-    } catch (...) {
-      std::signal(SIGINT, previous);
-      throw;
     }
-    std::signal(SIGINT, previous);
     if (!c->run.quiet) {
       fmt::print("map2d {}: {} scans, {} bridged, {:.2f} ms per scan ({:.0f} scans/s){}\n",
                  c->run.mapper.registration.method, s.scans, s.bridged, s.mean_ms,
