@@ -10,6 +10,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/trajectory.hpp"
@@ -50,10 +51,7 @@ class PointMap {
   void add(const PointCloud& cloud, const Pose& pose) {
     for (const Point& p : cloud.points) {
       const Eigen::Vector3d w = pose * p.cast<double>();
-      const Eigen::Vector3d s = (w / voxel_).array().floor();
-      const Key key{static_cast<std::int32_t>(s.x()), static_cast<std::int32_t>(s.y()),
-                    static_cast<std::int32_t>(s.z())};
-      if (cells_.insert(key).second) points_.push_back(w.cast<float>());
+      if (cells_.insert(voxel_key(w, voxel_)).second) points_.push_back(w.cast<float>());
     }
   }
   void keep_within(const Eigen::Vector3d& center, double radius) {
@@ -62,9 +60,7 @@ class PointMap {
     cells_.clear();
     for (const Point& p : points_) {
       if ((p.cast<double>() - center).squaredNorm() > r2) continue;
-      const Eigen::Vector3d s = (p.cast<double>() / voxel_).array().floor();
-      cells_.insert(Key{static_cast<std::int32_t>(s.x()), static_cast<std::int32_t>(s.y()),
-                        static_cast<std::int32_t>(s.z())});
+      cells_.insert(voxel_key(p.cast<double>(), voxel_));
       kept.push_back(p);
     }
     points_.swap(kept);
@@ -76,19 +72,8 @@ class PointMap {
   }
 
  private:
-  struct Key {
-    std::int32_t x, y, z;
-    bool operator==(const Key&) const = default;
-  };
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      return (static_cast<std::size_t>(k.x) * 73856093u) ^
-             (static_cast<std::size_t>(k.y) * 19349669u) ^
-             (static_cast<std::size_t>(k.z) * 83492791u);
-    }
-  };
   double voxel_;
-  std::unordered_set<Key, KeyHash> cells_;
+  std::unordered_set<VoxelKey, VoxelKeyHash> cells_;
   std::vector<Point> points_;
 };
 
