@@ -3,11 +3,9 @@
 
 #include <fmt/format.h>
 
-#include <atomic>
-#include <csignal>
-
 #include "apps/commands.hpp"
 #include "apps/config_options.hpp"
+#include "apps/interrupt.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/odometry/config_io.hpp"
@@ -16,11 +14,6 @@
 
 namespace scanmatch::cli {
 namespace {
-
-std::atomic<bool> interrupted{false};
-extern "C" void on_map2d_interrupt(int) {
-  interrupted.store(true);
-}
 
 struct Map2DCommand {
   std::string sequence, out, initial = "identity", topic, config_file;
@@ -100,17 +93,12 @@ void add_map2d_command(CLI::App& app) {
       input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
     }
     if (c->rotation_period >= 0.0) input.rotation_period = c->rotation_period;
-    interrupted.store(false);
-    run.stop = &interrupted;
-    const auto previous = std::signal(SIGINT, on_map2d_interrupt);
     Map2DSummary s;
-    try {
+    {
+      const InterruptFlag interrupt;
+      run.stop = interrupt.flag();
       s = run_map2d(input, c->out, run);
-    } catch (...) {
-      std::signal(SIGINT, previous);
-      throw;
     }
-    std::signal(SIGINT, previous);
     if (!c->run.quiet) {
       fmt::print("map2d {}: {} scans, {} bridged, {:.2f} ms per scan ({:.0f} scans/s){}\n",
                  run.mapper.registration.method, s.scans, s.bridged, s.mean_ms, s.scans_per_second,

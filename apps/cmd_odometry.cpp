@@ -3,27 +3,19 @@
 
 #include <fmt/format.h>
 
-#include <atomic>
-#include <csignal>
 #include <filesystem>
 
 #include "apps/commands.hpp"
 #include "apps/config_options.hpp"
+#include "apps/interrupt.hpp"
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/bag/bag_sequence.hpp"
-#include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/run.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch::cli {
 namespace {
-
-std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) {
-  interrupted.store(true);
-}
 
 struct OdometryCommand {
   std::string sequence, out, config_file, topic;
@@ -56,38 +48,19 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
   c.run.out_dir = c.out;
   c.run.max_frames = c.frames;
   c.run.quiet = c.quiet;
-  interrupted.store(false);
-  c.run.stop = &interrupted;
-  const auto previous = std::signal(SIGINT, on_interrupt);
   RunSummary summary;
-  try {
+  {
+    const InterruptFlag interrupt;
+    c.run.stop = interrupt.flag();
     summary = run_odometry(*source, config, c.run);
-  } catch (...) {
-    std::signal(SIGINT, previous);
-    throw;
   }
-  std::signal(SIGINT, previous);
-
   std::string accuracy;
-  if (const auto truth = source->ground_truth(); truth && summary.frames > 0) {
-    Trajectory gt;
-    const std::size_t n = std::min(summary.frames, truth->size());
-    gt.poses.assign(truth->poses.begin(), truth->poses.begin() + static_cast<std::ptrdiff_t>(n));
-    if (truth->has_timestamps())
-      gt.timestamps.assign(truth->timestamps.begin(),
-                           truth->timestamps.begin() + static_cast<std::ptrdiff_t>(n));
-    write_trajectory(c.out + "/poses_gt.txt", gt, TrajectoryFormat::kKitti);
-    if (gt.has_timestamps())
-      write_trajectory(c.out + "/poses_gt_tum.txt", gt, TrajectoryFormat::kTum);
-    const std::vector<Pose> estimate(summary.poses.begin(),
-                                     summary.poses.begin() + static_cast<std::ptrdiff_t>(n));
-    const AteResult ate = compute_ate(gt.poses, estimate);
-    accuracy = ate.path_length > 0.0
-                   ? fmt::format("ATE {:.3f} m RMSE, {:.3f} % of the {:.1f} m path", ate.rmse,
-                                 ate.rmse_percent_of_path, ate.path_length)
+  if (const auto& ate = summary.ate)
+    accuracy = ate->path_length > 0.0
+                   ? fmt::format("ATE {:.3f} m RMSE, {:.3f} % of the {:.1f} m path", ate->rmse,
+                                 ate->rmse_percent_of_path, ate->path_length)
                    : fmt::format("still sensor: final drift {:.4f} m, max {:.4f} m",
-                                 ate.final_drift, ate.max);
-  }
+                                 ate->final_drift, ate->max);
   if (!c.quiet) {
     std::printf("%s on %s: %zu frames, %.1f frames/s (pipeline %.2f ms/frame mean, %.2f max)%s\n",
                 summary.method.c_str(), summary.source.c_str(), summary.frames,

@@ -4,10 +4,13 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 #include <tuple>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/gaussian_voxel_map.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/geometry/voxel_key.hpp"
 
 using namespace scanmatch;
 
@@ -95,6 +98,34 @@ TEST(VoxelFilter, RejectsCoordinatesBeyondVoxelIndexRange) {
   PointCloud cloud;
   cloud.points = {Point(1e9f, 0, 0)};
   EXPECT_THROW(voxel_downsample(cloud, 0.01), Error);
+}
+
+TEST(VoxelKey, FloorsTowardsMinusInfinityInEitherPrecision) {
+  for (const double x : {-2.5, -2.0, -1e-9, 0.0, 1e-9, 0.999, 2.0, 1e9, -1e9})
+    EXPECT_EQ(floor_to_int(x), static_cast<std::int32_t>(std::floor(x))) << x;
+  for (const float x : {-2.5f, -2.0f, -1e-7f, 0.0f, 0.999f, 3.0f})
+    EXPECT_EQ(floor_to_int(x), static_cast<std::int32_t>(std::floor(x))) << x;
+  EXPECT_EQ(voxel_key_scaled(Eigen::Vector3f(-0.5f, 0.5f, -1.0f)), (VoxelKey{-1, 0, -1}));
+}
+
+TEST(VoxelKey, TheMapsDivideByTheVoxelSize) {
+  // 0.3 / 0.1 rounds below 3, 0.3 * (1 / 0.1) to 3: the maps keep the division they always had.
+  EXPECT_EQ(voxel_key(Eigen::Vector3d(0.3, -0.3, 0.7), 0.1), (VoxelKey{2, -3, 6}));
+  GaussianVoxelMapOptions o;
+  o.voxel_size = 0.1;
+  const GaussianVoxelMap map(o);
+  const Eigen::Vector3d p(0.3, -0.3, 0.7);
+  EXPECT_EQ(map.index_of(p), voxel_key(p, 0.1));
+}
+
+TEST(VoxelKey, HashSpreadsNeighbouringVoxelsOverTheSlots) {
+  // A 16^3 block of voxels into 4096 slots: x ^ y ^ z fills 16 of them, the classic 73856093
+  // multiply-xor 1981, a well-mixed hash about 4096 (1 - 1/e) = 2589.
+  std::set<std::size_t> slots;
+  for (int x = -8; x < 8; ++x)
+    for (int y = -8; y < 8; ++y)
+      for (int z = -8; z < 8; ++z) slots.insert(VoxelKeyHash{}(VoxelKey{x, y, z}) & 4095u);
+  EXPECT_GT(slots.size(), 2400u);
 }
 
 TEST(Crop, RangeBoxAndNonFinite) {

@@ -14,11 +14,8 @@ GaussianVoxelMap::GaussianVoxelMap(const GaussianVoxelMapOptions& options) : opt
     throw Error("Gaussian voxel map: merge threshold must be at least 1");
 }
 
-VoxelIndex GaussianVoxelMap::index_of(const Eigen::Vector3d& p) const {
-  const Eigen::Vector3d s = p / options_.voxel_size;
-  return {static_cast<std::int32_t>(std::floor(s.x())),
-          static_cast<std::int32_t>(std::floor(s.y())),
-          static_cast<std::int32_t>(std::floor(s.z()))};
+VoxelKey GaussianVoxelMap::index_of(const Eigen::Vector3d& p) const {
+  return voxel_key(p, options_.voxel_size);
 }
 
 const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {
@@ -34,16 +31,16 @@ void GaussianVoxelMap::rebuild_table(std::size_t capacity) {
   table_.assign(size, -1);
   const std::size_t mask = size - 1;
   for (std::size_t i = 0; i < indices_.size(); ++i) {
-    std::size_t slot = VoxelIndexHash{}(indices_[i]) & mask;
+    std::size_t slot = VoxelKeyHash{}(indices_[i]) & mask;
     while (table_[slot] >= 0) slot = (slot + 1) & mask;
     table_[slot] = static_cast<std::int32_t>(i);
   }
 }
 
-std::size_t GaussianVoxelMap::lookup_or_create(const VoxelIndex& index) {
+std::size_t GaussianVoxelMap::lookup_or_create(const VoxelKey& index) {
   if (2 * (voxels_.size() + 1) > table_.size()) rebuild_table(2 * (voxels_.size() + 1));
   const std::size_t mask = table_.size() - 1;
-  std::size_t slot = VoxelIndexHash{}(index)&mask;
+  std::size_t slot = VoxelKeyHash{}(index)&mask;
   for (;; slot = (slot + 1) & mask) {
     const std::int32_t at = table_[slot];
     if (at < 0) break;
@@ -104,7 +101,7 @@ void GaussianVoxelMap::update_cache(GaussianVoxel& v) const {
   v.regularized_information = Q * lambda.cwiseInverse().asDiagonal() * Q.transpose();
 }
 
-void GaussianVoxelMap::merge_pending(const VoxelIndex& index, GaussianVoxel& v) {
+void GaussianVoxelMap::merge_pending(const VoxelKey& index, GaussianVoxel& v) {
   if (v.pending == 0) return;
   const Eigen::Vector3d corner = Eigen::Vector3d(index.x, index.y, index.z) * options_.voxel_size;
   const double n = v.pending;
@@ -124,7 +121,7 @@ std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) 
   for (const Point& point : cloud.points) {
     const Eigen::Vector3d p = pose * point.cast<double>();
     if (!p.allFinite()) continue;
-    const VoxelIndex index = index_of(p);
+    const VoxelKey index = index_of(p);
     const std::size_t at = lookup_or_create(index);
     GaussianVoxel& v = voxels_[at];
     if (options_.max_points > 0 && v.count >= options_.max_points) continue;
@@ -158,7 +155,7 @@ std::size_t GaussianVoxelMap::remove_far(const Eigen::Vector3d& center, double r
   std::size_t kept = 0;
   for (std::size_t i = 0; i < voxels_.size(); ++i) {
     const GaussianVoxel& v = voxels_[i];
-    const VoxelIndex& k = indices_[i];
+    const VoxelKey& k = indices_[i];
     const Eigen::Vector3d where =
         v.count > 0 ? v.mean
                     : (Eigen::Vector3d(k.x, k.y, k.z) + Eigen::Vector3d::Constant(0.5)) *

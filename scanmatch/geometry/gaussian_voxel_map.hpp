@@ -11,26 +11,9 @@
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/core/se3.hpp"
+#include "scanmatch/geometry/voxel_key.hpp"
 
 namespace scanmatch {
-
-struct VoxelIndex {
-  std::int32_t x = 0, y = 0, z = 0;
-  bool operator==(const VoxelIndex&) const = default;
-};
-struct VoxelIndexHash {
-  std::size_t operator()(const VoxelIndex& v) const {
-    // Multiply-xor of the three coordinates, then a final avalanche so that the low bits (the
-    // open-addressing slot) depend on every coordinate bit.
-    std::uint64_t h =
-        static_cast<std::uint64_t>(static_cast<std::uint32_t>(v.x)) * 0x9E3779B97F4A7C15ull;
-    h ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(v.y)) * 0xC2B2AE3D27D4EB4Full;
-    h ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(v.z)) * 0x165667B19E3779F9ull;
-    h ^= h >> 29;
-    h *= 0xBF58476D1CE4E5B9ull;
-    return static_cast<std::size_t>(h ^ (h >> 32));
-  }
-};
 
 struct GaussianVoxel {
   // Hot: what registration reads per point (first cache lines).
@@ -75,16 +58,16 @@ class GaussianVoxelMap {
   /// Drops voxels whose mean is farther than `radius` from `center` (bounded map memory).
   std::size_t remove_far(const Eigen::Vector3d& center, double radius);
 
-  VoxelIndex index_of(const Eigen::Vector3d& p) const;
+  VoxelKey index_of(const Eigen::Vector3d& p) const;
   /// The usable voxel (count >= min_points) containing p, or nullptr.
   const GaussianVoxel* find(const Eigen::Vector3d& p) const;
   /// Calls f(voxel) for the usable voxels among p's voxel and its 6 (neighbours = 7) or 26
   /// (neighbours = 27) neighbours; neighbours = 1 is p's voxel only.
   template <typename F>
   void for_each_neighbour(const Eigen::Vector3d& p, int neighbours, F&& f) const {
-    const VoxelIndex c = index_of(p);
+    const VoxelKey c = index_of(p);
     for (const auto& o : offsets(neighbours)) {
-      const std::int32_t slot = lookup(VoxelIndex{c.x + o[0], c.y + o[1], c.z + o[2]});
+      const std::int32_t slot = lookup(VoxelKey{c.x + o[0], c.y + o[1], c.z + o[2]});
       if (slot >= 0 && voxels_[static_cast<std::size_t>(slot)].count >= options_.min_points)
         f(voxels_[static_cast<std::size_t>(slot)]);
     }
@@ -94,7 +77,7 @@ class GaussianVoxelMap {
   const GaussianVoxelMapOptions& options() const { return options_; }
   /// Every voxel (usable or not) and its index, in parallel, in no particular order.
   const std::vector<GaussianVoxel>& voxels() const { return voxels_; }
-  const std::vector<VoxelIndex>& indices() const { return indices_; }
+  const std::vector<VoxelKey>& indices() const { return indices_; }
 
   /// The merge of METHODS.md: (m, mu1, C1) + (n, mu2, C2) with the outer-product cross term.
   static void merge(GaussianVoxel& voxel, std::uint32_t n, const Eigen::Vector3d& mean,
@@ -102,19 +85,19 @@ class GaussianVoxelMap {
 
  private:
   static const std::vector<std::array<int, 3>>& offsets(int neighbours);
-  void merge_pending(const VoxelIndex& index, GaussianVoxel& voxel);
+  void merge_pending(const VoxelKey& index, GaussianVoxel& voxel);
   void update_cache(GaussianVoxel& voxel) const;
   /// Position of the voxel in voxels_, or -1.
-  std::int32_t lookup(const VoxelIndex& index) const {
+  std::int32_t lookup(const VoxelKey& index) const {
     if (table_.empty()) return -1;
     const std::size_t mask = table_.size() - 1;
-    for (std::size_t slot = VoxelIndexHash{}(index)&mask;; slot = (slot + 1) & mask) {
+    for (std::size_t slot = VoxelKeyHash{}(index)&mask;; slot = (slot + 1) & mask) {
       const std::int32_t at = table_[slot];
       if (at < 0 || indices_[static_cast<std::size_t>(at)] == index) return at;
     }
   }
   /// Position of the voxel, created when absent.
-  std::size_t lookup_or_create(const VoxelIndex& index);
+  std::size_t lookup_or_create(const VoxelKey& index);
   void rebuild_table(std::size_t capacity);
 
   GaussianVoxelMapOptions options_;
@@ -122,7 +105,7 @@ class GaussianVoxelMap {
   // Open addressing with linear probing: table_ holds positions into the dense arrays (-1: empty),
   // at most half full. Dense storage keeps iteration and removal cheap.
   std::vector<GaussianVoxel> voxels_;
-  std::vector<VoxelIndex> indices_;
+  std::vector<VoxelKey> indices_;
   std::vector<std::int32_t> table_;
 };
 

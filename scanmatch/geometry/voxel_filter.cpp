@@ -8,36 +8,10 @@
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/voxel_key.hpp"
 
 namespace scanmatch {
 namespace {
-
-struct VoxelKey {
-  std::int32_t x, y, z;
-  bool operator==(const VoxelKey&) const = default;
-};
-
-// std::floor is a library call without SSE4.1; truncation plus a correction is exact for |x| <
-// 2^31.
-inline std::int32_t fast_floor(float x) {
-  const auto t = static_cast<std::int32_t>(x);
-  return t - static_cast<std::int32_t>(x < static_cast<float>(t));
-}
-
-inline std::uint64_t hash_key(const VoxelKey& k) {
-  // Pack the three coordinates, then a full avalanche (murmur3's finaliser), so that neighbouring
-  // voxels spread over the whole table and linear probing stays short.
-  std::uint64_t h =
-      (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.x)) << 32) ^
-      (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.y)) << 16) ^
-      static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.z)) * 0x9E3779B97F4A7C15ull;
-  h ^= h >> 33;
-  h *= 0xFF51AFD7ED558CCDull;
-  h ^= h >> 33;
-  h *= 0xC4CEB9FE1A85EC53ull;
-  h ^= h >> 33;
-  return h;
-}
 
 // Open addressing with linear probing over 16-byte entries (key and dense voxel index side by
 // side). The table is sized by the number of voxels, not points, and grows at half load, so for a
@@ -58,7 +32,7 @@ class VoxelSlots {
   /// Returns the voxel's dense index, creating it (index = count so far) when new.
   std::uint32_t find_or_insert(const VoxelKey& key) {
     const std::size_t mask = entries_.size() - 1;
-    std::size_t i = static_cast<std::size_t>(hash_key(key)) & mask;
+    std::size_t i = VoxelKeyHash{}(key)&mask;
     while (true) {
       Entry& e = entries_[i];
       if (e.index == kEmpty) {
@@ -85,7 +59,7 @@ class VoxelSlots {
     const std::size_t mask = entries_.size() - 1;
     for (const Entry& e : old) {
       if (e.index == kEmpty) continue;
-      std::size_t i = static_cast<std::size_t>(hash_key(e.key)) & mask;
+      std::size_t i = VoxelKeyHash{}(e.key) & mask;
       while (entries_[i].index != kEmpty) i = (i + 1) & mask;
       entries_[i] = e;
     }
@@ -140,8 +114,7 @@ PointCloud voxel_downsample(const PointCloud& cloud, double voxel_size, VoxelRed
       fail("voxel_downsample", "point " + std::to_string(i) +
                                    " is too far from the origin for voxel size " +
                                    std::to_string(voxel_size));
-    const std::uint32_t v =
-        slots.find_or_insert(VoxelKey{fast_floor(s.x()), fast_floor(s.y()), fast_floor(s.z())});
+    const std::uint32_t v = slots.find_or_insert(voxel_key_scaled(s));
     if (v == voxels.size())
       voxels.push_back(Accumulator{Eigen::Vector3d::Zero(), 0, static_cast<std::uint32_t>(i)});
     voxels[v].sum += cloud.points[i].cast<double>();

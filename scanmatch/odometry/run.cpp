@@ -10,8 +10,10 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
+#include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 
 namespace scanmatch {
@@ -49,10 +51,7 @@ class PointMap {
   void add(const PointCloud& cloud, const Pose& pose) {
     for (const Point& p : cloud.points) {
       const Eigen::Vector3d w = pose * p.cast<double>();
-      const Eigen::Vector3d s = (w / voxel_).array().floor();
-      const Key key{static_cast<std::int32_t>(s.x()), static_cast<std::int32_t>(s.y()),
-                    static_cast<std::int32_t>(s.z())};
-      if (cells_.insert(key).second) points_.push_back(w.cast<float>());
+      if (cells_.insert(voxel_key(w, voxel_)).second) points_.push_back(w.cast<float>());
     }
   }
   void keep_within(const Eigen::Vector3d& center, double radius) {
@@ -61,9 +60,7 @@ class PointMap {
     cells_.clear();
     for (const Point& p : points_) {
       if ((p.cast<double>() - center).squaredNorm() > r2) continue;
-      const Eigen::Vector3d s = (p.cast<double>() / voxel_).array().floor();
-      cells_.insert(Key{static_cast<std::int32_t>(s.x()), static_cast<std::int32_t>(s.y()),
-                        static_cast<std::int32_t>(s.z())});
+      cells_.insert(voxel_key(p.cast<double>(), voxel_));
       kept.push_back(p);
     }
     points_.swap(kept);
@@ -75,19 +72,8 @@ class PointMap {
   }
 
  private:
-  struct Key {
-    std::int32_t x, y, z;
-    bool operator==(const Key&) const = default;
-  };
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      return (static_cast<std::size_t>(k.x) * 73856093u) ^
-             (static_cast<std::size_t>(k.y) * 19349669u) ^
-             (static_cast<std::size_t>(k.z) * 83492791u);
-    }
-  };
   double voxel_;
-  std::unordered_set<Key, KeyHash> cells_;
+  std::unordered_set<VoxelKey, VoxelKeyHash> cells_;
   std::vector<Point> points_;
 };
 
@@ -106,11 +92,45 @@ nlohmann::ordered_json stage_json(const StageStatistics& s) {
   return {{"mean_ms", s.mean_ms}, {"max_ms", s.max_ms}};
 }
 
+// The keys of `scanmatch eval --json`.
+nlohmann::ordered_json ate_json(const AteResult& ate) {
+  return {{"poses", ate.poses},
+          {"rmse_m", ate.rmse},
+          {"mean_m", ate.mean},
+          {"median_m", ate.median},
+          {"max_m", ate.max},
+          {"final_drift_m", ate.final_drift},
+          {"path_length_m", ate.path_length},
+          {"rmse_percent_of_path", ate.rmse_percent_of_path}};
+}
+
+// The ground truth of the frames run, and the estimate's ATE against it.
+void evaluate(const std::optional<Trajectory>& truth, RunSummary& summary) {
+  if (!truth || summary.frames == 0) return;
+  const auto n = static_cast<std::ptrdiff_t>(std::min(summary.frames, truth->size()));
+  summary.ground_truth.assign(truth->poses.begin(), truth->poses.begin() + n);
+  summary.ate = compute_ate(summary.ground_truth,
+                            std::vector<Pose>(summary.poses.begin(), summary.poses.begin() + n));
+}
+
+void write_ground_truth(const std::string& dir, const std::optional<Trajectory>& truth,
+                        const RunSummary& summary) {
+  if (summary.ground_truth.empty()) return;
+  Trajectory gt;
+  gt.poses = summary.ground_truth;
+  if (truth->has_timestamps())
+    gt.timestamps.assign(truth->timestamps.begin(),
+                         truth->timestamps.begin() + static_cast<std::ptrdiff_t>(gt.size()));
+  write_trajectory(dir + "/poses_gt.txt", gt, TrajectoryFormat::kKitti);
+  if (gt.has_timestamps()) write_trajectory(dir + "/poses_gt_tum.txt", gt, TrajectoryFormat::kTum);
+}
+
 }  // namespace
 
 RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                         const RunOptions& options) {
   Odometry odometry(config);
+  const std::optional<Trajectory> truth = source.ground_truth();
   RunSummary summary;
   summary.method = config.method;
   summary.source = source.describe();
@@ -189,6 +209,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   summary.map_update = statistics(summary.stats, &FrameStats::map_ms);
   summary.total = statistics(summary.stats, &FrameStats::total_ms);
   summary.frames_per_second = pipeline_ms > 0.0 ? 1000.0 * summary.frames / pipeline_ms : 0.0;
+  evaluate(truth, summary);
 
   if (write) {
     if (options.write_map) {
@@ -196,22 +217,23 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
         map.keep_within(summary.poses.back().translation(), options.map_export_radius);
       write_cloud(dir + "/map." + options.map_format, map.cloud());
     }
-    nlohmann::ordered_json j = {
-        {"method", summary.method},
-        {"source", summary.source},
-        {"frames", summary.frames},
-        {"bridged_frames", summary.bridged_frames},
-        {"interrupted", summary.interrupted},
-        {"error", summary.error},
-        {"frames_per_second", summary.frames_per_second},
-        {"threads", config.threads},
-        {"stages",
-         {{"preprocess", stage_json(summary.preprocess)},
-          {"coarse", stage_json(summary.coarse)},
-          {"fine", stage_json(summary.fine)},
-          {"map_update", stage_json(summary.map_update)},
-          {"total", stage_json(summary.total)}}},
-        {"options", nlohmann::ordered_json::parse(odometry_config_to_json(config))}};
+    write_ground_truth(dir, truth, summary);
+    nlohmann::ordered_json j = {{"method", summary.method},
+                                {"source", summary.source},
+                                {"frames", summary.frames},
+                                {"bridged_frames", summary.bridged_frames},
+                                {"interrupted", summary.interrupted},
+                                {"error", summary.error},
+                                {"frames_per_second", summary.frames_per_second},
+                                {"threads", config.threads},
+                                {"stages",
+                                 {{"preprocess", stage_json(summary.preprocess)},
+                                  {"coarse", stage_json(summary.coarse)},
+                                  {"fine", stage_json(summary.fine)},
+                                  {"map_update", stage_json(summary.map_update)},
+                                  {"total", stage_json(summary.total)}}}};
+    if (summary.ate) j["ate"] = ate_json(*summary.ate);
+    j["options"] = nlohmann::ordered_json::parse(odometry_config_to_json(config));
     write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");
   }
   if (!summary.error.empty()) throw Error(summary.error);

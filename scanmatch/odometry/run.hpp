@@ -2,12 +2,15 @@
 // Runs an odometry pipeline over a whole sequence and writes a run folder (RUNDIR):
 //   poses.txt       KITTI rows, one per frame, sensor pose in the world frame of frame 0
 //   poses_tum.txt   the same poses as TUM rows (timestamp tx ty tz qx qy qz qw)
+//   poses_gt.txt    when the source has ground truth: its poses for the frames run (KITTI rows),
+//   poses_gt_tum.txt  and as TUM rows when it has timestamps (written at the end)
 //   timing.csv      per frame: index,timestamp,preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,
 //                   points_in,points_downsampled,iterations,condition_number,
 //                   degenerate_directions,bridged
 //   summary.json    method, options (the whole configuration), frames, mean and max ms per stage,
 //                   frames per second, whether the run was interrupted, the error that ended it
-//                   early (written atomically at the end, also after such an error)
+//                   early, and the ATE when the source has ground truth (written atomically
+//                   at the end, also after such an error)
 //   config.json     the OdometryConfig used (reloadable with --config)
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
 // Per-frame files are appended and flushed frame by frame, so an interrupted run keeps its frames.
@@ -15,9 +18,11 @@
 
 #include <atomic>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/sequence.hpp"
 #include "scanmatch/odometry/odometry.hpp"
 
@@ -51,6 +56,11 @@ struct RunSummary {
   std::vector<double> timestamps;  ///< per frame
   std::vector<Pose> poses;         ///< per frame, world frame of frame 0
   std::vector<FrameStats> stats;   ///< per frame
+  /// The source's ground truth for the frames run (empty when it has none), as in poses_gt.txt.
+  std::vector<Pose> ground_truth;
+  /// ATE of `poses` against `ground_truth`, unaligned (both start at the identity, as the run
+  /// does); absent without ground truth or frames.
+  std::optional<AteResult> ate;
 };
 
 /// Runs `config` over `source` (from its current position) and writes RUNDIR as described above.
