@@ -4,6 +4,7 @@
 
 #include "apps/commands.hpp"
 #include "scanmatch/eval/metrics.hpp"
+#include "scanmatch/eval/metrics_json.hpp"
 #include "scanmatch/io/trajectory.hpp"
 
 namespace scanmatch::cli {
@@ -17,7 +18,7 @@ struct EvalOptions {
   double max_time_gap = 0.01;
 };
 
-nlohmann::json rpe_json(const RpeResult& r) {
+nlohmann::ordered_json rpe_json(const RpeResult& r) {
   return {{"pairs", r.pairs},
           {"translation_rmse_m", r.translation_rmse},
           {"translation_mean_m", r.translation_mean},
@@ -39,26 +40,18 @@ void run_eval(const EvalOptions& o) {
   const KittiDriftResult kitti = compute_kitti_drift(pairs.ground_truth, pairs.estimate);
 
   if (o.json) {
-    nlohmann::json j = {{"ground_truth", o.ground_truth},
-                        {"estimate", o.estimate},
-                        {"association", pairs.description},
-                        {"alignment", o.align},
-                        {"ate",
-                         {{"poses", ate.poses},
-                          {"rmse_m", ate.rmse},
-                          {"mean_m", ate.mean},
-                          {"median_m", ate.median},
-                          {"max_m", ate.max},
-                          {"final_drift_m", ate.final_drift},
-                          {"path_length_m", ate.path_length},
-                          {"rmse_percent_of_path", ate.rmse_percent_of_path},
-                          {"scale", ate.alignment.scale}}},
-                        {"rpe_frames", {{"delta_frames", o.rpe_frames}, {"result", rpe_json(rpe)}}},
-                        {"kitti",
-                         {{"segments", kitti.segments},
-                          {"translation_percent", kitti.translation_percent},
-                          {"rotation_deg_per_100m", kitti.rotation_deg_per_100m},
-                          {"lengths_m", kitti.lengths_used}}}};
+    nlohmann::ordered_json j = {
+        {"ground_truth", o.ground_truth},
+        {"estimate", o.estimate},
+        {"association", pairs.description},
+        {"alignment", o.align},
+        {"ate", ate_json(ate)},
+        {"rpe_frames", {{"delta_frames", o.rpe_frames}, {"result", rpe_json(rpe)}}},
+        {"kitti",
+         {{"segments", kitti.segments},
+          {"translation_percent", kitti.translation_percent},
+          {"rotation_deg_per_100m", kitti.rotation_deg_per_100m},
+          {"lengths_m", kitti.lengths_used}}}};
     if (with_distance_rpe)
       j["rpe_distance"] = {{"delta_m", o.rpe_distance}, {"result", rpe_json(rpe_distance)}};
     fmt::print("{}\n", j.dump(2));

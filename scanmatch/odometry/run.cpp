@@ -10,6 +10,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/eval/metrics_json.hpp"
 #include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
@@ -93,17 +94,6 @@ nlohmann::ordered_json stage_json(const StageStatistics& s) {
 }
 
 // The keys of `scanmatch eval --json`.
-nlohmann::ordered_json ate_json(const AteResult& ate) {
-  return {{"poses", ate.poses},
-          {"rmse_m", ate.rmse},
-          {"mean_m", ate.mean},
-          {"median_m", ate.median},
-          {"max_m", ate.max},
-          {"final_drift_m", ate.final_drift},
-          {"path_length_m", ate.path_length},
-          {"rmse_percent_of_path", ate.rmse_percent_of_path}};
-}
-
 // The ground truth of the frames run, and the estimate's ATE against it.
 void evaluate(const std::optional<Trajectory>& truth, RunSummary& summary) {
   if (!truth || summary.frames == 0) return;
