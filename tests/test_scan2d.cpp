@@ -1,4 +1,4 @@
-// 2D scan matching (METHODS.md section 2): each step of sparse-icp on hand-built scans, every
+// 2D scan matching (docs/methods.md section 2): each step of sparse-icp on hand-built scans, every
 // method on simulated pairs with exact ground truth, scan-to-scan mapping and its grid map against
 // the simulated floor plan, the CLI and the real CARMEN logs.
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 #pragma once
-// Angle histograms of 2D scans (METHODS.md section 2 step 1): the direction of the line through
-// each pair of consecutive points, binned over [0, 2 pi); the circular cross-correlation of two
-// histograms peaks at the rotation between the scans.
+// Angle histograms of 2D scans (docs/methods.md section 2 step 1): the direction of the line
+// through each pair of consecutive points, binned over [0, 2 pi); the circular cross-correlation of
+// two histograms peaks at the rotation between the scans.
 
 #include <Eigen/Core>
 #include <cmath>

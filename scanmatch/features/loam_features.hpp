@@ -1,5 +1,5 @@
 #pragma once
-// LOAM-style features (METHODS.md section 3): per ring, the smoothness
+// LOAM-style features (docs/methods.md section 3): per ring, the smoothness
 //   c_i = |sum_{j in S, j != i} (X_i - X_j)| / (|S| |X_i|)
 // over k neighbours on each side; each ring is cut into equal segments and each segment gives its
 // sharpest points (edges) and flattest points (planes).

@@ -2,7 +2,7 @@
 // The one voxel map of Gaussians (count, mean, covariance per voxel, addressed by a hash of the
 // integer voxel coordinate). It serves NDT, VGICP and the CTF-ICP fine stage, and is the CTF-ICP
 // global map: points accumulate per voxel and are merged into its Gaussian only once
-// `merge_threshold` new points are pending (METHODS.md section 1 step 4).
+// `merge_threshold` new points are pending (docs/methods.md section 1 step 4).
 
 #include <Eigen/Core>
 #include <array>
@@ -79,7 +79,7 @@ class GaussianVoxelMap {
   const std::vector<GaussianVoxel>& voxels() const { return voxels_; }
   const std::vector<VoxelKey>& indices() const { return indices_; }
 
-  /// The merge of METHODS.md: (m, mu1, C1) + (n, mu2, C2) with the outer-product cross term.
+  /// The merge of docs/methods.md: (m, mu1, C1) + (n, mu2, C2) with the outer-product cross term.
   static void merge(GaussianVoxel& voxel, std::uint32_t n, const Eigen::Vector3d& mean,
                     const Eigen::Matrix3d& covariance);
 

@@ -1,6 +1,7 @@
 #pragma once
-// 2D scan-to-scan mapping (METHODS.md section 2 step 6): each scan is registered onto the previous
-// one (or the last keyframe) from a motion prior and the results are chained into global poses.
+// 2D scan-to-scan mapping (docs/methods.md section 2 step 6): each scan is registered onto the
+// previous one (or the last keyframe) from a motion prior and the results are chained into global
+// poses.
 
 #include <cstddef>
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
 // LiDAR odometry: one pipeline configured by method.
 //
-// `ctf-icp` is METHODS.md section 1: deskew and voxel-downsample the frame; coarse stage NDT
+// `ctf-icp` is docs/methods.md section 1: deskew and voxel-downsample the frame; coarse stage NDT
 // frame-to-frame (against the previous frame's NDT grid, from the constant-velocity prior); fine
 // stage frame-to-map on the global Gaussian map with covariance eigenvalues normalised to
 // (1, 1, 1e-6); map update that merges a voxel once 5 new points are pending (merge rule of the

@@ -1,6 +1,6 @@
 #pragma once
-// Feature ICP on LOAM features (METHODS.md section 3): point-to-line residuals for edge points and
-// point-to-plane residuals for planar points, with the paper's neighbour choice, on the shared
+// Feature ICP on LOAM features (docs/methods.md section 3): point-to-line residuals for edge points
+// and point-to-plane residuals for planar points, with the paper's neighbour choice, on the shared
 // solver. Methods "loam" (both), "loam-edge" and "loam-plane".
 
 #include "scanmatch/features/loam_features.hpp"

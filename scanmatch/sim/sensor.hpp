@@ -1,6 +1,6 @@
 #pragma once
 // LiDAR sensor models: each a generator of ray directions, per-ray time offsets within the frame
-// and rings, with range limits, range noise and dropouts (the table in METHODS.md).
+// and rings, with range limits, range noise and dropouts (the table in docs/methods.md).
 
 #include <Eigen/Core>
 #include <cstdint>

@@ -1,7 +1,7 @@
 #pragma once
-// The CTF-ICP fine stage (METHODS.md section 1 step 3): r = T p - mu of the map voxel containing
-// T p, information Q diag(1/eps, 1, 1) Q^T (covariance eigenvalues normalised to (1, 1, eps)).
-// `register --method ctf-fine` and the odometry's fine stage both run register_ctf_fine.
+// The CTF-ICP fine stage (docs/methods.md section 1 step 3): r = T p - mu of the map voxel
+// containing T p, information Q diag(1/eps, 1, 1) Q^T (covariance eigenvalues normalised to (1, 1,
+// eps)). `register --method ctf-fine` and the odometry's fine stage both run register_ctf_fine.
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"

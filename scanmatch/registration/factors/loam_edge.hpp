@@ -1,5 +1,6 @@
 #pragma once
-// LOAM's edge factor (METHODS.md section 3): the target's edge features searched with a k-d tree.
+// LOAM's edge factor (docs/methods.md section 3): the target's edge features searched with a k-d
+// tree.
 
 #include <cstdlib>
 

@@ -1,6 +1,6 @@
 #pragma once
-// LOAM's planar factor (METHODS.md section 3): the target's planar features searched with a k-d
-// tree.
+// LOAM's planar factor (docs/methods.md section 3): the target's planar features searched with a
+// k-d tree.
 
 #include <cstdlib>
 

@@ -1,5 +1,5 @@
 #pragma once
-// sparse-icp's correspondences (METHODS.md section 2 steps 3-4): a path through the matrix of
+// sparse-icp's correspondences (docs/methods.md section 2 steps 3-4): a path through the matrix of
 // Manhattan distances between the current scan's points (columns) and the reference scan's
 // (rows), both in beam order, and the rules that mark its invalid pairs.
 

@@ -1,7 +1,7 @@
 #pragma once
-// 2D laser scan matching (METHODS.md section 2): the paper's sparse-correspondence method and the
-// baselines of its Table 1, registered by name through one table of methods. Scans and poses are
-// core/scan2d.hpp's.
+// 2D laser scan matching (docs/methods.md section 2): the paper's sparse-correspondence method and
+// the baselines of its Table 1, registered by name through one table of methods. Scans and poses
+// are core/scan2d.hpp's.
 //
 //   sparse-icp   angle-histogram rotation, (optionally) centroid translation, the
 //                Manhattan-distance correspondence path with invalid pairs dropped, then the
