@@ -245,7 +245,20 @@ TEST(BagCli, Map2dReadsLaserScans) {
   EXPECT_EQ(scans[2].ranges.size(), simulator.scan_2d(2).ranges.size());
   const auto r = run_cli("map2d " + bag + " --out " + dir.file("run") + " --quiet");
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_EQ(read_trajectory(dir.file("run/poses_tum.txt")).size(), 5u);
+  const Trajectory from_bag = read_trajectory(dir.file("run/poses_tum.txt"));
+  EXPECT_EQ(from_bag.size(), 5u);
+
+  // The same scans as a CARMEN log give the same poses.
+  CarmenLog log;
+  log.scans = scans;
+  write_carmen_log(dir.file("scans.log"), log);
+  const auto l =
+      run_cli("map2d " + dir.file("scans.log") + " --out " + dir.file("log_run") + " --quiet");
+  ASSERT_EQ(l.status, 0) << l.output;
+  const Trajectory from_log = read_trajectory(dir.file("log_run/poses_tum.txt"));
+  ASSERT_EQ(from_log.size(), from_bag.size());
+  for (std::size_t i = 0; i < from_bag.size(); ++i)
+    EXPECT_TRUE(from_bag.poses[i].matrix().isApprox(from_log.poses[i].matrix(), 1e-9)) << i;
 }
 
 }  // namespace
