@@ -6,12 +6,6 @@
 
 namespace scanmatch {
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
-
 Eigen::Matrix3d so3_exp(const Eigen::Vector3d& w) {
   const double theta2 = w.squaredNorm();
   const Eigen::Matrix3d W = skew(w);

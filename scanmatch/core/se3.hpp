@@ -14,7 +14,11 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 /// [v]_x: the matrix with skew(v) * w == v.cross(w).
-Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+inline Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return S;
+}
 
 /// Rodrigues: rotation by angle |w| about w / |w|; exact near zero.
 Eigen::Matrix3d so3_exp(const Eigen::Vector3d& w);

@@ -54,20 +54,6 @@ std::size_t GaussianVoxelMap::lookup_or_create(const VoxelKey& index) {
   return voxels_.size() - 1;
 }
 
-const std::vector<std::array<int, 3>>& GaussianVoxelMap::offsets(int neighbours) {
-  static const std::vector<std::array<int, 3>> one = {{0, 0, 0}};
-  static const std::vector<std::array<int, 3>> seven = {
-      {0, 0, 0}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  static const std::vector<std::array<int, 3>> all = [] {
-    std::vector<std::array<int, 3>> v;
-    for (int x = -1; x <= 1; ++x)
-      for (int y = -1; y <= 1; ++y)
-        for (int z = -1; z <= 1; ++z) v.push_back({x, y, z});
-    return v;
-  }();
-  return neighbours >= 27 ? all : neighbours >= 7 ? seven : one;
-}
-
 void GaussianVoxelMap::merge(GaussianVoxel& v, std::uint32_t n, const Eigen::Vector3d& mean,
                              const Eigen::Matrix3d& covariance) {
   if (n == 0) return;

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
@@ -84,7 +85,23 @@ class GaussianVoxelMap {
                     const Eigen::Matrix3d& covariance);
 
  private:
-  static const std::vector<std::array<int, 3>>& offsets(int neighbours);
+  /// Constant tables (no initialisation guard on the hot path), in the order the sums use.
+  static std::span<const std::array<int, 3>> offsets(int neighbours) {
+    static constexpr std::array<std::array<int, 3>, 1> kOne{{{0, 0, 0}}};
+    static constexpr std::array<std::array<int, 3>, 7> kSeven{
+        {{0, 0, 0}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}}};
+    static constexpr std::array<std::array<int, 3>, 27> kAll = [] {
+      std::array<std::array<int, 3>, 27> all{};
+      std::size_t i = 0;
+      for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+          for (int z = -1; z <= 1; ++z) all[i++] = {x, y, z};
+      return all;
+    }();
+    if (neighbours >= 27) return kAll;
+    if (neighbours >= 7) return kSeven;
+    return kOne;
+  }
   void merge_pending(const VoxelKey& index, GaussianVoxel& voxel);
   void update_cache(GaussianVoxel& voxel) const;
   /// Position of the voxel in voxels_, or -1.
