@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "scanmatch/core/error.hpp"
 #include "scanmatch/benchmark/benchmark.hpp"
 #include "scanmatch/benchmark/benchmark2d.hpp"
+#include "scanmatch/core/error.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;

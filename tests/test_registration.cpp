@@ -11,8 +11,8 @@
 #include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/cloud_io.hpp"
-#include "scanmatch/registration/solver.hpp"
 #include "scanmatch/registration/methods.hpp"
+#include "scanmatch/registration/solver.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
 
