@@ -238,7 +238,7 @@ TEST(Geometry, GaussianMapMergeEqualsBatchStatistics) {
   EXPECT_LT((v->covariance - cov).norm(), 1e-6);
   // The planar information has the smallest eigenvector as its stiff direction.
   const Eigen::Vector3d normal = v->normal;
-  EXPECT_NEAR(normal.dot(v->planar_information * normal), 1e6, 1.0);
+  EXPECT_NEAR(normal.dot(planar_information(*v, options.planar_epsilon) * normal), 1e6, 1.0);
   EXPECT_EQ(map.remove_far(Eigen::Vector3d(100, 0, 0), 10.0), 1u);
   EXPECT_EQ(map.size(), 0u);
 }

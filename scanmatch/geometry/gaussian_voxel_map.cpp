@@ -1,6 +1,7 @@
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -14,10 +15,6 @@ GaussianVoxelMap::GaussianVoxelMap(const GaussianVoxelMapOptions& options) : opt
     throw Error("Gaussian voxel map: merge threshold must be at least 1");
 }
 
-VoxelKey GaussianVoxelMap::index_of(const Eigen::Vector3d& p) const {
-  return voxel_key(p, options_.voxel_size);
-}
-
 const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {
   const std::int32_t slot = lookup(index_of(p));
   if (slot < 0) return nullptr;
@@ -28,12 +25,12 @@ const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {
 void GaussianVoxelMap::rebuild_table(std::size_t capacity) {
   std::size_t size = 16;
   while (size < 2 * capacity) size *= 2;
-  table_.assign(size, -1);
+  table_.assign(size, Slot{});
   const std::size_t mask = size - 1;
   for (std::size_t i = 0; i < indices_.size(); ++i) {
     std::size_t slot = VoxelKeyHash{}(indices_[i]) & mask;
-    while (table_[slot] >= 0) slot = (slot + 1) & mask;
-    table_[slot] = static_cast<std::int32_t>(i);
+    while (table_[slot].at >= 0) slot = (slot + 1) & mask;
+    table_[slot] = Slot{indices_[i], static_cast<std::int32_t>(i)};
   }
 }
 
@@ -42,16 +39,22 @@ std::size_t GaussianVoxelMap::lookup_or_create(const VoxelKey& index) {
   const std::size_t mask = table_.size() - 1;
   std::size_t slot = VoxelKeyHash{}(index)&mask;
   for (;; slot = (slot + 1) & mask) {
-    const std::int32_t at = table_[slot];
-    if (at < 0) break;
-    if (indices_[static_cast<std::size_t>(at)] == index) return static_cast<std::size_t>(at);
+    const Slot& s = table_[slot];
+    if (s.at < 0) break;
+    if (s.key == index) return static_cast<std::size_t>(s.at);
   }
   if (voxels_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw Error("Gaussian voxel map: too many voxels");
-  table_[slot] = static_cast<std::int32_t>(voxels_.size());
+  table_[slot] = Slot{index, static_cast<std::int32_t>(voxels_.size())};
   voxels_.emplace_back();
   indices_.push_back(index);
   return voxels_.size() - 1;
+}
+
+void GaussianVoxelMap::clear() {
+  voxels_.clear();
+  indices_.clear();
+  std::fill(table_.begin(), table_.end(), Slot{});
 }
 
 void GaussianVoxelMap::merge(GaussianVoxel& v, std::uint32_t n, const Eigen::Vector3d& mean,
@@ -79,10 +82,8 @@ void GaussianVoxelMap::update_cache(GaussianVoxel& v) const {
   v.normal = Q.col(0);
   const Eigen::Vector3d& e = solver.eigenvalues();
   v.flatness = e(1) > 0.0 ? static_cast<float>(std::max(e(0), 0.0) / e(1)) : 1.0f;
-  const double eps = options_.planar_epsilon;
-  v.planar_information = Q * Eigen::Vector3d(1.0 / eps, 1.0, 1.0).asDiagonal() * Q.transpose();
-  const Eigen::Vector3d lambda =
-      solver.eigenvalues().cwiseMax(1e-3 * std::max(solver.eigenvalues()(2), 1e-6));
+  if (!options_.distributions) return;
+  const Eigen::Vector3d lambda = e.cwiseMax(1e-3 * std::max(e(2), 1e-6));
   v.regularized_covariance = Q * lambda.asDiagonal() * Q.transpose();
   v.regularized_information = Q * lambda.cwiseInverse().asDiagonal() * Q.transpose();
 }

@@ -16,18 +16,19 @@
 
 namespace scanmatch {
 
-struct GaussianVoxel {
-  // Hot: what registration reads per point (first cache lines).
+/// 64-byte aligned so that what the CTF-ICP fine stage reads per point (count, flatness, mean,
+/// normal) shares one cache line.
+struct alignas(64) GaussianVoxel {
+  // Hot: what registration reads per point.
   std::uint32_t count = 0;  ///< points merged into the Gaussian
   /// Smallest over middle eigenvalue: near 0 for a plane, up to 1 for a blob or a corner.
   float flatness = 1.0f;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  /// Cached from the covariance after each merge:
-  Eigen::Matrix3d planar_information = Eigen::Matrix3d::Identity();  ///< (Q diag(1,1,eps) Q^T)^-1
-  Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d regularized_covariance =
-      Eigen::Matrix3d::Identity();                    ///< eigenvalues >= 1e-3 max
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
+  /// Cached after each merge when the map's options ask for them (NDT, VGICP); eigenvalues
+  /// clamped to >= 1e-3 of the largest.
+  Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d regularized_covariance = Eigen::Matrix3d::Identity();
   // Cold: the statistics and the points waiting to be merged.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< population covariance
   /// Points waiting to be merged (sums relative to the voxel's corner for precision).
@@ -37,6 +38,12 @@ struct GaussianVoxel {
   Eigen::Matrix3d pending_outer = Eigen::Matrix3d::Zero();
 };
 
+/// The CTF-ICP planar information (Q diag(1/eps, 1, 1) Q^T, the covariance's eigenvalues
+/// normalised to (eps, 1, 1)), which is I + (1/eps - 1) n n^T for the voxel normal n.
+inline Eigen::Matrix3d planar_information(const GaussianVoxel& voxel, double epsilon) {
+  return Eigen::Matrix3d::Identity() + (1.0 / epsilon - 1.0) * voxel.normal * voxel.normal.transpose();
+}
+
 struct GaussianVoxelMapOptions {
   double voxel_size = 1.0;            ///< m
   std::uint32_t merge_threshold = 1;  ///< pending points needed before a merge (CTF-ICP: 5)
@@ -45,6 +52,9 @@ struct GaussianVoxelMapOptions {
   /// A voxel whose Gaussian holds this many points takes no more (0: no limit). Mature voxels then
   /// stay fixed, so small registration errors of later frames cannot drag the map along.
   std::uint32_t max_points = 0;
+  /// Cache each voxel's regularised covariance and information (NDT, VGICP read them); the CTF-ICP
+  /// fine stage reads only the mean and normal, and its map skips them.
+  bool distributions = true;
 };
 
 class GaussianVoxelMap {
@@ -56,22 +66,35 @@ class GaussianVoxelMap {
   std::size_t insert(const PointCloud& cloud, const Pose& pose = Pose::Identity());
   /// Merges every voxel's pending points regardless of the threshold.
   void flush();
+  /// Removes every voxel but keeps the allocations (a map rebuilt every frame).
+  void clear();
   /// Drops voxels whose mean is farther than `radius` from `center` (bounded map memory).
   std::size_t remove_far(const Eigen::Vector3d& center, double radius);
 
-  VoxelKey index_of(const Eigen::Vector3d& p) const;
+  VoxelKey index_of(const Eigen::Vector3d& p) const { return voxel_key(p, options_.voxel_size); }
   /// The usable voxel (count >= min_points) containing p, or nullptr.
   const GaussianVoxel* find(const Eigen::Vector3d& p) const;
   /// Calls f(voxel) for the usable voxels among p's voxel and its 6 (neighbours = 7) or 26
   /// (neighbours = 27) neighbours; neighbours = 1 is p's voxel only.
   template <typename F>
   void for_each_neighbour(const Eigen::Vector3d& p, int neighbours, F&& f) const {
+    const GaussianVoxel* found[27];
+    const int count = gather_neighbours(p, neighbours, found);
+    for (int k = 0; k < count; ++k) f(*found[k]);
+  }
+
+  /// The same voxels as for_each_neighbour, written to `out` (room for `neighbours`, at most 27);
+  /// returns how many. For hot loops: a plain loop over them inlines where a callback may not.
+  int gather_neighbours(const Eigen::Vector3d& p, int neighbours,
+                        const GaussianVoxel** out) const {
     const VoxelKey c = index_of(p);
+    int found = 0;
     for (const auto& o : offsets(neighbours)) {
       const std::int32_t slot = lookup(VoxelKey{c.x + o[0], c.y + o[1], c.z + o[2]});
       if (slot >= 0 && voxels_[static_cast<std::size_t>(slot)].count >= options_.min_points)
-        f(voxels_[static_cast<std::size_t>(slot)]);
+        out[found++] = &voxels_[static_cast<std::size_t>(slot)];
     }
+    return found;
   }
 
   std::size_t size() const { return voxels_.size(); }
@@ -104,13 +127,14 @@ class GaussianVoxelMap {
   }
   void merge_pending(const VoxelKey& index, GaussianVoxel& voxel);
   void update_cache(GaussianVoxel& voxel) const;
-  /// Position of the voxel in voxels_, or -1.
+  /// Position of the voxel in voxels_, or -1. The slot holds the key itself, so a probe reads one
+  /// cache line of the table and nothing else.
   std::int32_t lookup(const VoxelKey& index) const {
     if (table_.empty()) return -1;
     const std::size_t mask = table_.size() - 1;
     for (std::size_t slot = VoxelKeyHash{}(index)&mask;; slot = (slot + 1) & mask) {
-      const std::int32_t at = table_[slot];
-      if (at < 0 || indices_[static_cast<std::size_t>(at)] == index) return at;
+      const Slot& s = table_[slot];
+      if (s.at < 0 || s.key == index) return s.at;
     }
   }
   /// Position of the voxel, created when absent.
@@ -119,11 +143,15 @@ class GaussianVoxelMap {
 
   GaussianVoxelMapOptions options_;
   std::uint64_t insert_calls_ = 0;
-  // Open addressing with linear probing: table_ holds positions into the dense arrays (-1: empty),
-  // at most half full. Dense storage keeps iteration and removal cheap.
+  // Open addressing with linear probing: table_ holds keys and positions into the dense arrays
+  // (at < 0: empty), at most half full. Dense storage keeps iteration and removal cheap.
+  struct Slot {
+    VoxelKey key;
+    std::int32_t at = -1;
+  };
   std::vector<GaussianVoxel> voxels_;
   std::vector<VoxelKey> indices_;
-  std::vector<std::int32_t> table_;
+  std::vector<Slot> table_;
 };
 
 }  // namespace scanmatch

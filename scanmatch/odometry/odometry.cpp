@@ -24,6 +24,7 @@ GaussianVoxelMapOptions map_options(const OdometryConfig& c) {
   o.planar_epsilon = c.registration.ctf_epsilon;
   o.max_points = c.map_voxel_max_points;
   o.min_points = c.map_voxel_min_points;
+  o.distributions = false;  // the fine stage reads means and normals only
   return o;
 }
 
@@ -53,6 +54,7 @@ void check_config(const OdometryConfig& c) {
   positive(c.map_voxel_size, "map_voxel_size");
   positive(c.map_radius, "map_radius");
   positive(c.max_range, "max_range");
+  positive(c.coarse_tolerance, "coarse_tolerance");
   if (c.voxel_size < 0.0 || c.coarse_voxel_size < 0.0 || c.min_range < 0.0)
     throw Error("odometry: voxel sizes and min_range must not be negative");
   if (c.merge_threshold == 0) throw Error("odometry: merge_threshold must be at least 1");
@@ -71,7 +73,9 @@ class FrameMotion {
       bins_[k] = se3_exp(xi_ * (k * step_ - reference)).matrix().cast<float>();
   }
   Point apply(const Point& p, float t) const {
-    const int k = std::clamp(static_cast<int>(std::lround(t / step_)), 0, kBins - 1);
+    // Rounding by truncation (not std::lround, a library call per point): equal for t >= 0, and
+    // the clamp maps any negative time to the first bin either way.
+    const int k = std::clamp(static_cast<int>(t / step_ + 0.5), 0, kBins - 1);
     const float ds = t - static_cast<float>(k * step_);
     const Eigen::Vector3f w = xi_.head<3>().cast<float>(), v = xi_.tail<3>().cast<float>();
     const Point q = p + ds * (w.cross(p) + v);
@@ -154,7 +158,7 @@ Pose Odometry::register_ctf(const PointCloud& down, const PointCloud& coarse_sou
   if (previous_ndt_.size() > 0) {
     SolverOptions solver = config_.registration.solver;
     solver.max_iterations = config_.coarse_max_iterations;
-    solver.rotation_tolerance = solver.translation_tolerance = 1e-4;
+    solver.rotation_tolerance = solver.translation_tolerance = config_.coarse_tolerance;
     solver.kernel = RobustKernel{};
     const RegistrationResult coarse =
         optimize(NdtFactor{coarse_source, previous_ndt_, config_.ndt_neighbours, ndt_d1_, ndt_d2_},
@@ -258,11 +262,11 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
       }
     } else if (config_.fine_stage && down.size() > 0) {
       // Ablation: the fine stage sees only the previous frame (no map building or update).
-      map_ = GaussianVoxelMap(map_options(config_));
+      map_.clear();
       map_.insert(down, estimate);
       map_.flush();
     }
-    previous_ndt_ = GaussianVoxelMap(ndt_options(config_));
+    previous_ndt_.clear();
     previous_ndt_.insert(down);
     stats_.map_ms = ms_since(map_start);
   }

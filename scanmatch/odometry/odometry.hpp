@@ -33,6 +33,7 @@ struct OdometryConfig {
   int ndt_neighbours = 1;          ///< voxels per point: 1, 7 or 27
   double coarse_voxel_size = 0.7;  ///< m, further downsampling of the NDT source (0: none)
   int coarse_max_iterations = 30;
+  double coarse_tolerance = 1e-4;  ///< m and rad: the coarse stage stops below this update
   // Fine stage (ctf-icp): frame-to-map.
   double map_voxel_size = 0.5;        ///< m, the global Gaussian map
   std::uint32_t merge_threshold = 5;  ///< points pending before a map voxel is merged

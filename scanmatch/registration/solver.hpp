@@ -9,7 +9,12 @@
 //   bool linearize(const Pose& T, std::size_t i, LinearSystem& system, const RobustKernel& kernel)
 //   const;
 // which finds element i's correspondence under T and adds its residual through
-// LinearSystem::add (returning false when it has none). The solver owns everything else.
+// LinearSystem::add (returning false when it has none). A factor on a hot path may instead
+// provide
+//   void linearize_range(const Pose& T, std::size_t begin, std::size_t end, LinearSystem& system,
+//                        const RobustKernel& kernel) const;
+// for elements [begin, end), accumulating in its own form first (see SensorCentredSystem).
+// The solver owns everything else.
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
@@ -124,6 +129,31 @@ inline Eigen::Matrix<double, 3, 6> point_jacobian(const Pose& T, const Eigen::Ve
   return J;
 }
 
+/// Normal equations in the sensor-centred, world-aligned perturbation x' = x + w x y + v, where
+/// y = R p is the point rotated but not translated. There the Jacobian of a point is
+/// [-[y]x, I], whose products reduce to cross products and a few sums; add_to() turns them into
+/// the solver's body perturbation (T exp(delta): delta = diag(R^T, R^T) [w; v], exactly).
+struct SensorCentredSystem {
+  Matrix6d H = Matrix6d::Zero();
+  Vector6d b = Vector6d::Zero();
+  double cost = 0.0, squared_error = 0.0;
+  std::size_t inliers = 0;
+  void add_to(LinearSystem& system, const Eigen::Matrix3d& R) const {
+    Matrix6d H_body;
+    const Eigen::Matrix3d Rt = R.transpose();
+    H_body.topLeftCorner<3, 3>().noalias() = Rt * H.topLeftCorner<3, 3>() * R;
+    H_body.topRightCorner<3, 3>().noalias() = Rt * H.topRightCorner<3, 3>() * R;
+    H_body.bottomLeftCorner<3, 3>() = H_body.topRightCorner<3, 3>().transpose();
+    H_body.bottomRightCorner<3, 3>().noalias() = Rt * H.bottomRightCorner<3, 3>() * R;
+    system.H += H_body;
+    system.b.head<3>() += Rt * b.head<3>();
+    system.b.tail<3>() += Rt * b.tail<3>();
+    system.cost += cost;
+    system.squared_error += squared_error;
+    system.inliers += inliers;
+  }
+};
+
 struct SolverOptions {
   int max_iterations = 30;
   double rotation_tolerance = 1e-5;     ///< rad: converged when the update is smaller ...
@@ -180,7 +210,10 @@ LinearSystem reduce_parallel(
 template <typename Factor>
 LinearSystem linearize_all(const Factor& factor, const Pose& T, const SolverOptions& options) {
   const auto block = [&](std::size_t begin, std::size_t end, LinearSystem& system) {
-    for (std::size_t i = begin; i < end; ++i) factor.linearize(T, i, system, options.kernel);
+    if constexpr (requires { factor.linearize_range(T, begin, end, system, options.kernel); })
+      factor.linearize_range(T, begin, end, system, options.kernel);
+    else
+      for (std::size_t i = begin; i < end; ++i) factor.linearize(T, i, system, options.kernel);
   };
   if (options.num_threads <= 1) {
     LinearSystem system;

@@ -9,8 +9,9 @@
 
 namespace scanmatch {
 
-/// That information is exactly I + (1/eps - 1) n n^T with n the voxel normal, which lets the
-/// normal equations be formed from a 6-vector instead of 6x3 products (the odometry's hot loop).
+/// That information is exactly I + k n n^T (k = 1/eps - 1, n the voxel normal), so the normal
+/// equations of the points are sums of a few moments of y = R p plus the outer products of the
+/// 6-vector g = [y x n; n] (SensorCentredSystem): the odometry's hot loop.
 struct CtfFineFactor {
   const PointCloud& source;
   const GaussianVoxelMap& map;
@@ -19,38 +20,50 @@ struct CtfFineFactor {
   /// foliage) and are skipped; 1 keeps every voxel, as the paper does.
   float max_flatness = 1.0f;
   std::size_t size() const { return source.size(); }
-  bool linearize(const Pose& T, std::size_t i, LinearSystem& system,
-                 const RobustKernel& kernel) const {
-    const Eigen::Vector3d p = source.points[i].cast<double>(), x = T * p;
+  void linearize_range(const Pose& T, std::size_t begin, std::size_t end, LinearSystem& system,
+                       const RobustKernel& kernel) const {
     const double stiffness = 1.0 / map.options().planar_epsilon - 1.0;
     const Eigen::Matrix3d& R = T.linear();
-    bool any = false;
-    map.for_each_neighbour(x, neighbours, [&](const GaussianVoxel& v) {
-      if (v.flatness > max_flatness) return;
-      const Eigen::Vector3d r = x - v.mean;
-      const double along_normal = v.normal.dot(r);
-      const double s = r.squaredNorm() + stiffness * along_normal * along_normal;
-      const double w = kernel.weight(s);
-      // J^T u = [p x (R^T u); R^T u] for J = [-R [p]x, R].
-      const Eigen::Vector3d Rn = R.transpose() * v.normal, Rr = R.transpose() * r;
-      Vector6d g, Jr;
-      g << p.cross(Rn), Rn;
-      Jr << p.cross(Rr), Rr;
-      // J^T J = [[|p|^2 I - p p^T, [p]x], [-[p]x, I]].
-      Matrix6d JtJ;
-      const Eigen::Matrix3d px = skew(p);
-      JtJ.topLeftCorner<3, 3>() = p.squaredNorm() * Eigen::Matrix3d::Identity() - p * p.transpose();
-      JtJ.topRightCorner<3, 3>() = px;
-      JtJ.bottomLeftCorner<3, 3>() = -px;
-      JtJ.bottomRightCorner<3, 3>().setIdentity();
-      system.H.noalias() += w * (JtJ + stiffness * g * g.transpose());
-      system.b.noalias() += w * (Jr + stiffness * along_normal * g);
-      system.cost += kernel.cost(s);
-      system.squared_error += r.squaredNorm();
-      ++system.inliers;
-      any = true;
-    });
-    return any;
+    const Eigen::Vector3d t = T.translation();
+    SensorCentredSystem centred;
+    // J^T J = [[|y|^2 I - y y^T, [y]x], [-[y]x, I]] for J = [-[y]x, I]: summed as moments.
+    double sum_w = 0.0;
+    Eigen::Vector3d sum_wy = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d sum_wyy = Eigen::Matrix3d::Zero();
+    const GaussianVoxel* found[27];
+    for (std::size_t i = begin; i < end; ++i) {
+      const Eigen::Vector3d y = R * source.points[i].cast<double>(), x = y + t;
+      const int count = map.gather_neighbours(x, neighbours, found);
+      for (int k = 0; k < count; ++k) {
+        const GaussianVoxel& v = *found[k];
+        if (v.flatness > max_flatness) continue;
+        const Eigen::Vector3d r = x - v.mean;
+        const double along_normal = v.normal.dot(r);
+        const double rr = r.squaredNorm();
+        const double s = rr + stiffness * along_normal * along_normal;
+        const double w = kernel.weight(s);
+        Vector6d g;
+        g << y.cross(v.normal), v.normal;
+        centred.H.noalias() += (w * stiffness) * g * g.transpose();
+        sum_w += w;
+        sum_wy += w * y;
+        sum_wyy.noalias() += (w * y) * y.transpose();
+        // J^T u for the weighted residual u = w (I + k n n^T) r.
+        const Eigen::Vector3d u = w * (r + stiffness * along_normal * v.normal);
+        centred.b.head<3>() += y.cross(u);
+        centred.b.tail<3>() += u;
+        centred.cost += kernel.cost(s);
+        centred.squared_error += rr;
+        ++centred.inliers;
+      }
+    }
+    const Eigen::Matrix3d sum_wy_skew = skew(sum_wy);
+    centred.H.topLeftCorner<3, 3>() +=
+        sum_wyy.trace() * Eigen::Matrix3d::Identity() - sum_wyy;
+    centred.H.topRightCorner<3, 3>() += sum_wy_skew;
+    centred.H.bottomLeftCorner<3, 3>() -= sum_wy_skew;
+    centred.H.bottomRightCorner<3, 3>() += sum_w * Eigen::Matrix3d::Identity();
+    centred.add_to(system, R);
   }
 };
 

@@ -28,19 +28,48 @@ struct NdtFactor {
   int neighbours;
   double d1, d2;  ///< ndt_score_constants for the voxel size and outlier ratio
   std::size_t size() const { return source.size(); }
-  bool linearize(const Pose& T, std::size_t i, LinearSystem& system, const RobustKernel&) const {
-    const Eigen::Vector3d p = source.points[i].cast<double>(), x = T * p;
-    const Eigen::Matrix<double, 3, 6> J = point_jacobian(T, p);
-    bool any = false;
-    target_map.for_each_neighbour(x, neighbours, [&](const GaussianVoxel& v) {
-      const Eigen::Vector3d r = x - v.mean;
-      const double q = r.dot(v.regularized_information * r);
-      const double e = std::exp(-0.5 * d2 * q);
-      if (e < 1e-12) return;
-      system.add_weighted<3>(J, r, v.regularized_information, -0.5 * d1 * d2 * e, d1 * e);
-      any = true;
-    });
-    return any;
+  /// Sensor-centred (SensorCentredSystem): for J = [-[y]x, I] and information W,
+  /// J^T W J = [[-M [y]x, M], [M^T, W]] with M = [y]x W, and J^T W r = [y x W r; W r].
+  void linearize_range(const Pose& T, std::size_t begin, std::size_t end, LinearSystem& system,
+                       const RobustKernel&) const {
+    const Eigen::Matrix3d& R = T.linear();
+    const Eigen::Vector3d t = T.translation();
+    SensorCentredSystem centred;
+    Eigen::Matrix3d rotation_block = Eigen::Matrix3d::Zero(), cross_block = rotation_block,
+                    translation_block = rotation_block;
+    const GaussianVoxel* found[27];
+    for (std::size_t i = begin; i < end; ++i) {
+      const Eigen::Vector3d y = R * source.points[i].cast<double>(), x = y + t;
+      const int count = target_map.gather_neighbours(x, neighbours, found);
+      for (int k = 0; k < count; ++k) {
+        const GaussianVoxel& v = *found[k];
+        const Eigen::Vector3d r = x - v.mean;
+        const Eigen::Matrix3d& W = v.regularized_information;
+        const Eigen::Vector3d Wr = W * r;
+        const double q = r.dot(Wr);
+        const double e = std::exp(-0.5 * d2 * q);
+        if (e < 1e-12) continue;
+        const double weight = -0.5 * d1 * d2 * e;  // IRLS weight of the score (d1 < 0)
+        Eigen::Matrix3d M, MyT;  // M = [y]x W: column j is y x W_j
+        for (int j = 0; j < 3; ++j) M.col(j) = y.cross(W.col(j));
+        // -M [y]x: row i is y x M_i (as a row), since m^T [y]x = (m x y)^T.
+        for (int j = 0; j < 3; ++j) MyT.row(j) = y.cross(M.row(j).transpose()).transpose();
+        rotation_block.noalias() += weight * MyT;
+        cross_block.noalias() += weight * M;
+        translation_block.noalias() += weight * W;
+        const Eigen::Vector3d u = weight * Wr;
+        centred.b.head<3>() += y.cross(u);
+        centred.b.tail<3>() += u;
+        centred.cost += d1 * e;
+        centred.squared_error += r.squaredNorm();
+        ++centred.inliers;
+      }
+    }
+    centred.H.topLeftCorner<3, 3>() = rotation_block;
+    centred.H.topRightCorner<3, 3>() = cross_block;
+    centred.H.bottomLeftCorner<3, 3>() = cross_block.transpose();
+    centred.H.bottomRightCorner<3, 3>() = translation_block;
+    centred.add_to(system, R);
   }
 };
 
