@@ -32,7 +32,8 @@ const StageState& state() {
     o.preset = "dynamic-outdoor-fast";
     o.frames = 61;
     const sim::Simulator sim(o);
-    for (std::size_t i = 0; i < 60; ++i) st->odometry.register_frame(sim.frame(i), sim.frame_time(i));
+    for (std::size_t i = 0; i < 60; ++i)
+      st->odometry.register_frame(sim.frame(i), sim.frame_time(i));
     st->previous = st->odometry.last_frame();
     st->previous_pose = st->odometry.last_internal_pose();
     GaussianVoxelMapOptions ndt;
@@ -53,8 +54,8 @@ const StageState& state() {
 
 void per_point(benchmark::State& bench, std::size_t points) {
   bench.counters["ns_per_point"] = benchmark::Counter(
-      static_cast<double>(points), benchmark::Counter::kIsIterationInvariantRate |
-                                       benchmark::Counter::kInvert);
+      static_cast<double>(points),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   bench.counters["points"] = static_cast<double>(points);
 }
 
@@ -63,7 +64,8 @@ void BM_StageFloorProbe(benchmark::State& bench) {
   const Pose& T = s.estimate;
   for (auto _ : bench) {
     std::size_t hits = 0;
-    for (const Point& p : s.down.points) hits += s.odometry.map().find(T * p.cast<double>()) != nullptr;
+    for (const Point& p : s.down.points)
+      hits += s.odometry.map().find(T * p.cast<double>()) != nullptr;
     benchmark::DoNotOptimize(hits);
   }
   per_point(bench, s.down.size());
@@ -92,7 +94,8 @@ void BM_StageFineLinearize(benchmark::State& bench) {
   const CtfFineFactor factor{s.down, s.odometry.map(), 1, 1.0f};
   SolverOptions solver;
   solver.kernel.type = KernelType::kCauchy;
-  solver.kernel.scale = s.config.fine_kernel_distance / std::sqrt(s.config.registration.ctf_epsilon);
+  solver.kernel.scale =
+      s.config.fine_kernel_distance / std::sqrt(s.config.registration.ctf_epsilon);
   for (auto _ : bench) benchmark::DoNotOptimize(linearize_all(factor, s.estimate, solver));
   per_point(bench, s.down.size());
 }

@@ -74,6 +74,8 @@ void GaussianVoxelMap::merge(GaussianVoxel& v, std::uint32_t n, const Eigen::Vec
 }
 
 void GaussianVoxelMap::update_cache(GaussianVoxel& v) const {
+  // Nothing reads a voxel below min_points; the merge that brings it there computes the cache.
+  if (v.count < options_.min_points) return;
   // Closed-form 3x3 eigen decomposition: several times faster than the iterative one, and accurate
   // enough in double precision for normals and regularisation.
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;

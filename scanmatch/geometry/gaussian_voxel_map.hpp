@@ -19,14 +19,16 @@ namespace scanmatch {
 /// 64-byte aligned so that what the CTF-ICP fine stage reads per point (count, flatness, mean,
 /// normal) shares one cache line.
 struct alignas(64) GaussianVoxel {
-  // Hot: what registration reads per point.
+  // Hot: what registration reads per point. flatness, normal and the distributions are derived
+  // from the covariance after each merge that leaves count >= the map's min_points (below it the
+  // voxel is not used and they keep their defaults).
   std::uint32_t count = 0;  ///< points merged into the Gaussian
   /// Smallest over middle eigenvalue: near 0 for a plane, up to 1 for a blob or a corner.
   float flatness = 1.0f;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
-  /// Cached after each merge when the map's options ask for them (NDT, VGICP); eigenvalues
-  /// clamped to >= 1e-3 of the largest.
+  /// Only when the map's options ask for them (NDT, VGICP); eigenvalues clamped to >= 1e-3 of
+  /// the largest.
   Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d regularized_covariance = Eigen::Matrix3d::Identity();
   // Cold: the statistics and the points waiting to be merged.
@@ -41,7 +43,8 @@ struct alignas(64) GaussianVoxel {
 /// The CTF-ICP planar information (Q diag(1/eps, 1, 1) Q^T, the covariance's eigenvalues
 /// normalised to (eps, 1, 1)), which is I + (1/eps - 1) n n^T for the voxel normal n.
 inline Eigen::Matrix3d planar_information(const GaussianVoxel& voxel, double epsilon) {
-  return Eigen::Matrix3d::Identity() + (1.0 / epsilon - 1.0) * voxel.normal * voxel.normal.transpose();
+  return Eigen::Matrix3d::Identity() +
+         (1.0 / epsilon - 1.0) * voxel.normal * voxel.normal.transpose();
 }
 
 struct GaussianVoxelMapOptions {
@@ -85,8 +88,7 @@ class GaussianVoxelMap {
 
   /// The same voxels as for_each_neighbour, written to `out` (room for `neighbours`, at most 27);
   /// returns how many. For hot loops: a plain loop over them inlines where a callback may not.
-  int gather_neighbours(const Eigen::Vector3d& p, int neighbours,
-                        const GaussianVoxel** out) const {
+  int gather_neighbours(const Eigen::Vector3d& p, int neighbours, const GaussianVoxel** out) const {
     const VoxelKey c = index_of(p);
     int found = 0;
     for (const auto& o : offsets(neighbours)) {

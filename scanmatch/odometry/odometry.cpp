@@ -160,6 +160,8 @@ Pose Odometry::register_ctf(const PointCloud& down, const PointCloud& coarse_sou
     solver.max_iterations = config_.coarse_max_iterations;
     solver.rotation_tolerance = solver.translation_tolerance = config_.coarse_tolerance;
     solver.kernel = RobustKernel{};
+    // The fine stage re-linearises anyway: the coarse result needs no pass at its final pose.
+    solver.final_linearization = false;
     const RegistrationResult coarse =
         optimize(NdtFactor{coarse_source, previous_ndt_, config_.ndt_neighbours, ndt_d1_, ndt_d2_},
                  velocity_, solver);

@@ -58,8 +58,7 @@ struct CtfFineFactor {
       }
     }
     const Eigen::Matrix3d sum_wy_skew = skew(sum_wy);
-    centred.H.topLeftCorner<3, 3>() +=
-        sum_wyy.trace() * Eigen::Matrix3d::Identity() - sum_wyy;
+    centred.H.topLeftCorner<3, 3>() += sum_wyy.trace() * Eigen::Matrix3d::Identity() - sum_wyy;
     centred.H.topRightCorner<3, 3>() += sum_wy_skew;
     centred.H.bottomLeftCorner<3, 3>() -= sum_wy_skew;
     centred.H.bottomRightCorner<3, 3>() += sum_w * Eigen::Matrix3d::Identity();

@@ -50,7 +50,7 @@ struct NdtFactor {
         const double e = std::exp(-0.5 * d2 * q);
         if (e < 1e-12) continue;
         const double weight = -0.5 * d1 * d2 * e;  // IRLS weight of the score (d1 < 0)
-        Eigen::Matrix3d M, MyT;  // M = [y]x W: column j is y x W_j
+        Eigen::Matrix3d M, MyT;                    // M = [y]x W: column j is y x W_j
         for (int j = 0; j < 3; ++j) M.col(j) = y.cross(W.col(j));
         // -M [y]x: row i is y x M_i (as a row), since m^T [y]x = (m x y)^T.
         for (int j = 0; j < 3; ++j) MyT.row(j) = y.cross(M.row(j).transpose()).transpose();
