@@ -13,6 +13,9 @@ GaussianVoxelMap::GaussianVoxelMap(const GaussianVoxelMapOptions& options) : opt
   if (!(options.voxel_size > 0.0)) throw Error("Gaussian voxel map: voxel size must be positive");
   if (options.merge_threshold == 0)
     throw Error("Gaussian voxel map: merge threshold must be at least 1");
+  inverse_size_ = 1.0 / options.voxel_size;
+  int exponent = 0;
+  exact_inverse_ = std::frexp(options.voxel_size, &exponent) == 0.5;
 }
 
 const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {

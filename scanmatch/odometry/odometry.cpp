@@ -178,6 +178,7 @@ Pose Odometry::register_ctf(const PointCloud& down, const PointCloud& coarse_sou
     fine_options.max_iterations = config_.fine_max_iterations;
     fine_options.tolerance = config_.fine_tolerance;
     fine_options.max_flatness = static_cast<float>(config_.fine_max_flatness);
+    fine_options.with_cost = false;  // the odometry reads the pose, inliers and information
     SolverOptions& solver = fine_options.solver;
     solver = config_.registration.solver;
     solver.degeneracy_ratio = config_.degeneracy_ratio;

@@ -19,6 +19,9 @@ struct CtfFineFactor {
   /// Voxels whose flatness (smallest / middle eigenvalue) exceeds this are not planes (corners,
   /// foliage) and are skipped; 1 keeps every voxel, as the paper does.
   float max_flatness = 1.0f;
+  /// false: the system's cost stays 0 (it costs a logarithm per point with the Cauchy kernel,
+  /// and plain Gauss-Newton stopping on the step size never reads it).
+  bool with_cost = true;
   std::size_t size() const { return source.size(); }
   void linearize_range(const Pose& T, std::size_t begin, std::size_t end, LinearSystem& system,
                        const RobustKernel& kernel) const {
@@ -52,7 +55,7 @@ struct CtfFineFactor {
         const Eigen::Vector3d u = w * (r + stiffness * along_normal * v.normal);
         centred.b.head<3>() += y.cross(u);
         centred.b.tail<3>() += u;
-        centred.cost += kernel.cost(s);
+        if (with_cost) centred.cost += kernel.cost(s);
         centred.squared_error += rr;
         ++centred.inliers;
       }
@@ -71,6 +74,7 @@ struct CtfFineOptions {
   double tolerance = 1e-5;    ///< m and rad: converged when a step is smaller in both
   int neighbours = 1;         ///< voxels per point: 1 (the paper), 7 or 27
   float max_flatness = 1.0f;  ///< skip voxels less planar than this (1: all, as the paper)
+  bool with_cost = true;      ///< false: the result's cost is 0 (saves a logarithm per point)
   SolverOptions solver;       ///< kernel, threads and degeneracy guard (its iteration limits,
                               ///< tolerances and LM switch are replaced by the fields above)
 };
@@ -88,8 +92,9 @@ inline RegistrationResult register_ctf_fine(const PointCloud& source, const Gaus
   solver.relative_cost_tolerance = 0.0;
   solver.levenberg_marquardt = false;
   solver.final_linearization = false;
-  return optimize(CtfFineFactor{source, map, options.neighbours, options.max_flatness}, initial,
-                  solver);
+  return optimize(
+      CtfFineFactor{source, map, options.neighbours, options.max_flatness, options.with_cost},
+      initial, solver);
 }
 
 }  // namespace scanmatch
