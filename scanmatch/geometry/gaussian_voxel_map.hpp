@@ -47,6 +47,13 @@ inline Eigen::Matrix3d planar_information(const GaussianVoxel& voxel, double eps
          (1.0 / epsilon - 1.0) * voxel.normal * voxel.normal.transpose();
 }
 
+/// Where a point's voxel was found last (GaussianVoxelMap::find with a hint).
+struct VoxelHint {
+  static constexpr std::int32_t kUnknown = -2;
+  VoxelKey key;
+  std::int32_t slot = kUnknown;  ///< position in the map's voxels, -1: no voxel
+};
+
 struct GaussianVoxelMapOptions {
   double voxel_size = 1.0;            ///< m
   std::uint32_t merge_threshold = 1;  ///< pending points needed before a merge (CTF-ICP: 5)
@@ -82,6 +89,16 @@ class GaussianVoxelMap {
   }
   /// The usable voxel (count >= min_points) containing p, or nullptr.
   const GaussianVoxel* find(const Eigen::Vector3d& p) const;
+  /// The same, remembering p's voxel in `hint`: a point that stays in its voxel between the
+  /// iterations of one registration skips the hash probe. The map must not change while hints
+  /// are in use.
+  const GaussianVoxel* find(const Eigen::Vector3d& p, VoxelHint& hint) const {
+    const VoxelKey key = index_of(p);
+    if (hint.slot == VoxelHint::kUnknown || !(hint.key == key)) hint = VoxelHint{key, lookup(key)};
+    if (hint.slot < 0) return nullptr;
+    const GaussianVoxel& v = voxels_[static_cast<std::size_t>(hint.slot)];
+    return v.count >= options_.min_points ? &v : nullptr;
+  }
   /// Calls f(voxel) for the usable voxels among p's voxel and its 6 (neighbours = 7) or 26
   /// (neighbours = 27) neighbours; neighbours = 1 is p's voxel only.
   template <typename F>

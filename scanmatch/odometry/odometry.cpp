@@ -162,9 +162,9 @@ Pose Odometry::register_ctf(const PointCloud& down, const PointCloud& coarse_sou
     solver.kernel = RobustKernel{};
     // The fine stage re-linearises anyway: the coarse result needs no pass at its final pose.
     solver.final_linearization = false;
-    const RegistrationResult coarse =
-        optimize(NdtFactor{coarse_source, previous_ndt_, config_.ndt_neighbours, ndt_d1_, ndt_d2_},
-                 velocity_, solver);
+    NdtFactor factor{coarse_source, previous_ndt_, config_.ndt_neighbours, ndt_d1_, ndt_d2_};
+    if (config_.ndt_neighbours == 1) factor.hints.resize(coarse_source.size());
+    const RegistrationResult coarse = optimize(factor, velocity_, solver);
     stats_.iterations = coarse.iterations;
     stats_.condition_number = coarse.condition_number;
     if (coarse.inliers >= kMinimumPoints) estimate = pose_ * coarse.transform;

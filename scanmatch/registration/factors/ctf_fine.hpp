@@ -3,6 +3,8 @@
 // containing T p, information Q diag(1/eps, 1, 1) Q^T (covariance eigenvalues normalised to (1, 1,
 // eps)). `register --method ctf-fine` and the odometry's fine stage both run register_ctf_fine.
 
+#include <vector>
+
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"
 #include "scanmatch/registration/solver.hpp"
@@ -22,6 +24,9 @@ struct CtfFineFactor {
   /// false: the system's cost stays 0 (it costs a logarithm per point with the Cauchy kernel,
   /// and plain Gauss-Newton stopping on the step size never reads it).
   bool with_cost = true;
+  /// One per source point (neighbours = 1 only), or empty: remembers each point's voxel between
+  /// iterations. Ranges of points are disjoint, so threads write disjoint hints.
+  mutable std::vector<VoxelHint> hints = {};
   std::size_t size() const { return source.size(); }
   void linearize_range(const Pose& T, std::size_t begin, std::size_t end, LinearSystem& system,
                        const RobustKernel& kernel) const {
@@ -36,7 +41,13 @@ struct CtfFineFactor {
     const GaussianVoxel* found[27];
     for (std::size_t i = begin; i < end; ++i) {
       const Eigen::Vector3d y = R * source.points[i].cast<double>(), x = y + t;
-      const int count = map.gather_neighbours(x, neighbours, found);
+      int count;
+      if (hints.empty()) {
+        count = map.gather_neighbours(x, neighbours, found);
+      } else {
+        found[0] = map.find(x, hints[i]);
+        count = found[0] != nullptr;
+      }
       for (int k = 0; k < count; ++k) {
         const GaussianVoxel& v = *found[k];
         if (v.flatness > max_flatness) continue;
@@ -92,9 +103,9 @@ inline RegistrationResult register_ctf_fine(const PointCloud& source, const Gaus
   solver.relative_cost_tolerance = 0.0;
   solver.levenberg_marquardt = false;
   solver.final_linearization = false;
-  return optimize(
-      CtfFineFactor{source, map, options.neighbours, options.max_flatness, options.with_cost},
-      initial, solver);
+  CtfFineFactor factor{source, map, options.neighbours, options.max_flatness, options.with_cost};
+  if (options.neighbours == 1) factor.hints.resize(source.size());
+  return optimize(factor, initial, solver);
 }
 
 }  // namespace scanmatch

@@ -5,6 +5,7 @@
 // keeps the Hessian positive definite far from the optimum.
 
 #include <cmath>
+#include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"
@@ -27,6 +28,8 @@ struct NdtFactor {
   const GaussianVoxelMap& target_map;
   int neighbours;
   double d1, d2;  ///< ndt_score_constants for the voxel size and outlier ratio
+  /// As CtfFineFactor::hints: one per source point when neighbours = 1, or empty.
+  mutable std::vector<VoxelHint> hints = {};
   std::size_t size() const { return source.size(); }
   /// Sensor-centred (SensorCentredSystem): for J = [-[y]x, I] and information W,
   /// J^T W J = [[-M [y]x, M], [M^T, W]] with M = [y]x W, and J^T W r = [y x W r; W r].
@@ -40,7 +43,13 @@ struct NdtFactor {
     const GaussianVoxel* found[27];
     for (std::size_t i = begin; i < end; ++i) {
       const Eigen::Vector3d y = R * source.points[i].cast<double>(), x = y + t;
-      const int count = target_map.gather_neighbours(x, neighbours, found);
+      int count;
+      if (hints.empty()) {
+        count = target_map.gather_neighbours(x, neighbours, found);
+      } else {
+        found[0] = target_map.find(x, hints[i]);
+        count = found[0] != nullptr;
+      }
       for (int k = 0; k < count; ++k) {
         const GaussianVoxel& v = *found[k];
         const Eigen::Vector3d r = x - v.mean;
