@@ -79,8 +79,8 @@ void add_simulate_command(CLI::App& app) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!*quiet)
       fmt::print("{}: {} frames of {} ({} m path) in {:.1f} s ({:.0f} frames/s) -> {}\n",
-                 simulator.preset().name, written, simulator.sensor().name,
-                 simulator.path_length(), seconds, static_cast<double>(written) / seconds, *out);
+                 simulator.preset().name, written, simulator.sensor().name, simulator.path_length(),
+                 seconds, static_cast<double>(written) / seconds, *out);
   });
 }
 

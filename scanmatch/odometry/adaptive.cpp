@@ -122,8 +122,8 @@ PointCloud adaptive_downsample(const PointCloud& cloud, const OdometryConfig& co
   double voxel = config.voxel_size;
   PointCloud down = voxel_downsample(cloud, voxel);
   // Halve the voxel (twice at most) while a sparse frame keeps too few points to register.
-  for (int k = 0; k < 2 && down.size() < config.min_downsampled_points && down.size() < cloud.size();
-       ++k) {
+  for (int k = 0;
+       k < 2 && down.size() < config.min_downsampled_points && down.size() < cloud.size(); ++k) {
     voxel *= 0.5;
     down = voxel_downsample(cloud, voxel);
   }

@@ -86,7 +86,8 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("coarse_voxel_size", c.coarse_voxel_size, nullptr, "ctf-icp: downsampling of the NDT source");
   v("coarse_max_iterations", c.coarse_max_iterations, "--coarse-max-iterations",
     "ctf-icp: the coarse NDT stage's iteration limit");
-  v("coarse_tolerance", c.coarse_tolerance, nullptr, "ctf-icp: the coarse stage's update tolerance");
+  v("coarse_tolerance", c.coarse_tolerance, nullptr,
+    "ctf-icp: the coarse stage's update tolerance");
   v("map_voxel_size", c.map_voxel_size, "--map-voxel",
     "ctf-icp: the global Gaussian map's voxel, m");
   v("merge_threshold", c.merge_threshold, "--merge-threshold",

@@ -175,12 +175,11 @@ Pose Odometry::register_ctf(const PointCloud& down, const PointCloud& coarse_sou
     stats_.condition_number = coarse.condition_number;
     if (coarse.inliers >= kMinimumPoints) estimate = pose_ * coarse.transform;
     if (adaptive_.prior.uncertain)  // first frames, irregular steps: check other starts
-      estimate = pose_ * coarse_multi_start(coarse_source, previous_, previous_ndt_,
-                                            coarse.inliers >= kMinimumPoints
-                                                ? coarse.transform
-                                                : adaptive_.prior.motion,
-                                            adaptive_.prior.motion, solver, config_,
-                                            stats_.iterations);
+      estimate =
+          pose_ * coarse_multi_start(
+                      coarse_source, previous_, previous_ndt_,
+                      coarse.inliers >= kMinimumPoints ? coarse.transform : adaptive_.prior.motion,
+                      adaptive_.prior.motion, solver, config_, stats_.iterations);
   }
   stats_.coarse_ms = ms_since(coarse_start);
 
