@@ -233,12 +233,20 @@ TEST(AdaptiveRules, ASparseFrameKeepsMorePointsADenseOneIsUnchanged) {
   for (int i = 0; i < 1500; ++i)
     sparse.points.emplace_back(5.0f, -1.5f + 3.0f * float(i % 39) / 39.0f,
                                -1.5f + 3.0f * float(i / 39) / 39.0f);
-  const PointCloud more = adaptive_downsample(sparse, c);
+  const PointCloud more = adaptive_downsample(sparse, sparse.size(), c);
   EXPECT_GT(more.size(), 4 * voxel_downsample(sparse, c.voxel_size).size());
   EXPECT_LE(more.size(), sparse.size());
+  // A frame delivered dense (10x the floor) that sees only a near wall keeps the plain filter.
+  PointCloud wall;
+  for (int i = 0; i < 10000; ++i)
+    wall.points.emplace_back(1.0f, -1.0f + 2.0f * float(i % 100) / 100.0f,
+                             -1.0f + 2.0f * float(i / 100) / 100.0f);
+  EXPECT_EQ(adaptive_downsample(wall, wall.size(), c).points,
+            voxel_downsample(wall, c.voxel_size).points);
   // 40 x 40 m of ground every 0.1 m: 25600 voxels, more than enough.
   for (int i = 0; i < 400; ++i)
     for (int j = 0; j < 400; ++j)
       dense.points.emplace_back(-20.0f + 0.1f * i, -20.0f + 0.1f * j, -1.0f);
-  EXPECT_EQ(adaptive_downsample(dense, c).points, voxel_downsample(dense, c.voxel_size).points);
+  EXPECT_EQ(adaptive_downsample(dense, dense.size(), c).points,
+            voxel_downsample(dense, c.voxel_size).points);
 }

@@ -16,6 +16,8 @@ constexpr std::size_t kMinimumInliers = 20;
 /// Another start replaces the plain coarse result only when its NDT score is better by this
 /// fraction: starts that reach the same optimum never move a pose.
 constexpr double kScoreMargin = 0.01;
+/// Frames with this many times min_downsampled_points before the voxel filter are dense.
+constexpr std::size_t kDenseFactor = 10;
 
 Pose scaled(const Pose& motion, double factor) {
   return se3_exp(factor * se3_log(motion));
@@ -117,10 +119,15 @@ Pose coarse_multi_start(const PointCloud& source, const PointCloud& previous,
   return best;
 }
 
-PointCloud adaptive_downsample(const PointCloud& cloud, const OdometryConfig& config) {
+PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
+                               const OdometryConfig& config) {
   if (config.voxel_size <= 0.0) return cloud;
   double voxel = config.voxel_size;
   PointCloud down = voxel_downsample(cloud, voxel);
+  // Only frames delivered sparse (FAST-LIO keyframes): a dense frame that keeps few points sees a
+  // near wall or is mostly within min_range, and finer voxels there did not help (dynamic-indoor:
+  // 0.1864 -> 0.1878 % ATE when applied to those frames too).
+  if (delivered >= kDenseFactor * config.min_downsampled_points) return down;
   // Halve the voxel (twice at most) while a sparse frame keeps too few points to register.
   for (int k = 0;
        k < 2 && down.size() < config.min_downsampled_points && down.size() < cloud.size(); ++k) {

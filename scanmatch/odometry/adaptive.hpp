@@ -10,8 +10,9 @@
 // - Uncertain prior: the coarse stage also tries other starts (identity, half and twice the prior
 //   motion), each first on a wider NDT grid of the previous frame, and keeps the one with the best
 //   NDT score at the normal resolution; the jump gate widens by uncertain_jump_scale.
-// - Sizes from the frame itself: a frame that keeps fewer than min_downsampled_points after the
-//   voxel filter is downsampled again with a smaller voxel (down to a quarter of voxel_size).
+// - Sizes from the frame itself: a sparse frame (delivered with fewer than 10 x
+//   min_downsampled_points points) that keeps fewer than min_downsampled_points after the voxel
+//   filter is downsampled again with a smaller voxel (down to a quarter of voxel_size).
 //
 // With regular time steps, an accurate prior and dense frames none of this changes a pose.
 
@@ -47,8 +48,10 @@ Pose coarse_multi_start(const PointCloud& source, const PointCloud& previous,
                         const Pose& prior_motion, const SolverOptions& solver,
                         const OdometryConfig& config, int& iterations);
 
-/// The voxel filter with the point floor: `voxel_size`, then smaller voxels while fewer than
-/// min_downsampled_points remain (at most down to voxel_size / 4).
-PointCloud adaptive_downsample(const PointCloud& cloud, const OdometryConfig& config);
+/// The voxel filter with the point floor: `voxel_size`, then, for a frame delivered with fewer than
+/// 10 x min_downsampled_points points (`delivered`, before the range crop), smaller voxels while
+/// fewer than min_downsampled_points remain (at most down to voxel_size / 4).
+PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
+                               const OdometryConfig& config);
 
 }  // namespace scanmatch

@@ -125,7 +125,8 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("uncertain_jump_scale", c.uncertain_jump_scale, nullptr,
     "max_jump and max_jump_angle widen by this factor under an uncertain prior");
   v("min_downsampled_points", c.min_downsampled_points, nullptr,
-    "frames keeping fewer points are downsampled with smaller voxels, to voxel_size / 4 (0: off)");
+    "sparse frames (below 10x this) keeping fewer points get smaller voxels, to voxel_size / 4 "
+    "(0: off)");
   v("threads", c.threads, "--threads", "Threads (1 for fair comparisons)");
   v.nested("registration", c.registration);
 }

@@ -132,7 +132,7 @@ PointCloud Odometry::preprocess(const PointCloud& frame) const {
     if (frame.has_ring()) kept.ring.push_back(frame.ring[i]);
     if (frame.has_intensity()) kept.intensity.push_back(frame.intensity[i]);
   }
-  return adaptive_downsample(kept, config_);
+  return adaptive_downsample(kept, frame.size(), config_);
 }
 
 Pose Odometry::register_baseline(const PointCloud& down, const Pose& predicted) {
