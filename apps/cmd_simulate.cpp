@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cmath>
 
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/sim/keyframes.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch::cli {
@@ -18,6 +20,9 @@ void add_simulate_command(CLI::App& app) {
   auto no_distortion = std::make_shared<bool>(false);
   auto no_noise = std::make_shared<bool>(false);
   auto list = std::make_shared<bool>(false);
+  auto keyframes = std::make_shared<sim::KeyframeOptions>();
+  auto angle_deg = std::make_shared<double>(0.0);
+  auto no_point_time = std::make_shared<bool>(false);
   std::string preset_help = "Preset:";
   for (const auto& p : sim::presets())
     preset_help +=
@@ -33,6 +38,18 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_flag("--no-motion-distortion", *no_distortion,
                 "Measure every point of a frame from the frame's start pose");
   cmd->add_flag("--no-noise", *no_noise, "No range noise and no dropouts");
+  cmd->add_option("--every", keyframes->every, "Keyframes: keep every Nth frame");
+  cmd->add_option("--keyframe-distance", keyframes->distance,
+                  "Keyframes: keep a frame once the sensor moved this many m since the last kept");
+  cmd->add_option("--keyframe-distance-max", keyframes->distance_max,
+                  "Keyframes: irregular steps, a random threshold in [--keyframe-distance, this] "
+                  "m per keyframe (seeded by --seed)");
+  cmd->add_option("--keyframe-angle", *angle_deg,
+                  "Keyframes: keep a frame once the sensor turned this many degrees");
+  cmd->add_option("--max-points", keyframes->max_points,
+                  "Random subsample of every written frame to at most N points");
+  cmd->add_flag("--no-point-time", *no_point_time,
+                "Write frames without the per-point time field (like FAST-LIO keyframe folders)");
   cmd->add_flag("--list", *list, "List the presets and exit");
   cmd->add_flag("--quiet", *quiet, "No progress display");
   cmd->callback([=] {
@@ -46,15 +63,24 @@ void add_simulate_command(CLI::App& app) {
     options->motion_distortion = !*no_distortion;
     options->noise = !*no_noise;
     const auto start = std::chrono::steady_clock::now();
+    keyframes->angle = *angle_deg * M_PI / 180.0;
+    keyframes->point_time = !*no_point_time;
+    keyframes->seed = options->seed;
+    sim::check_keyframe_options(*keyframes);
     const sim::Simulator simulator(*options);
-    sim::write_dataset(simulator, *out, *quiet);
+    std::size_t written = simulator.size();
+    if (keyframes->active()) {
+      sim::write_keyframe_dataset(simulator, *keyframes, *out, *quiet);
+      written = sim::select_keyframes(simulator, *keyframes).size();
+    } else {
+      sim::write_dataset(simulator, *out, *quiet);
+    }
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!*quiet)
       fmt::print("{}: {} frames of {} ({} m path) in {:.1f} s ({:.0f} frames/s) -> {}\n",
-                 simulator.preset().name, simulator.size(), simulator.sensor().name,
-                 simulator.path_length(), seconds, static_cast<double>(simulator.size()) / seconds,
-                 *out);
+                 simulator.preset().name, written, simulator.sensor().name, simulator.path_length(),
+                 seconds, static_cast<double>(written) / seconds, *out);
   });
 }
 

@@ -86,7 +86,8 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("coarse_voxel_size", c.coarse_voxel_size, nullptr, "ctf-icp: downsampling of the NDT source");
   v("coarse_max_iterations", c.coarse_max_iterations, "--coarse-max-iterations",
     "ctf-icp: the coarse NDT stage's iteration limit");
-  v("coarse_tolerance", c.coarse_tolerance, nullptr, "ctf-icp: the coarse stage's update tolerance");
+  v("coarse_tolerance", c.coarse_tolerance, nullptr,
+    "ctf-icp: the coarse stage's update tolerance");
   v("map_voxel_size", c.map_voxel_size, "--map-voxel",
     "ctf-icp: the global Gaussian map's voxel, m");
   v("merge_threshold", c.merge_threshold, "--merge-threshold",
@@ -110,6 +111,22 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("deskew_min_rotation", c.deskew_min_rotation, nullptr, "deskew dead band, rad per frame");
   v("max_jump", c.max_jump, nullptr, "results farther from the prior are rejected, m");
   v("max_jump_angle", c.max_jump_angle, nullptr, "likewise for rotation, rad");
+  v("time_scaled_prior", c.time_scaled_prior, nullptr,
+    "scale the constant-velocity prior by the ratio of the frame time steps");
+  v("max_step_ratio", c.max_step_ratio, nullptr,
+    "time-step ratios beyond this (or its inverse) make the prior uncertain");
+  v("prior_miss_distance", c.prior_miss_distance, nullptr,
+    "an estimate this far from its prior makes the next prior uncertain, m");
+  v("prior_miss_angle", c.prior_miss_angle, nullptr, "likewise for rotation, rad");
+  v("uncertain_starts", c.uncertain_starts, nullptr,
+    "ctf-icp, uncertain prior: also try the identity, half and twice the prior motion");
+  v("uncertain_ndt_scale", c.uncertain_ndt_scale, nullptr,
+    "ctf-icp: those starts run first on an NDT grid this many times ndt_resolution");
+  v("uncertain_jump_scale", c.uncertain_jump_scale, nullptr,
+    "max_jump and max_jump_angle widen by this factor under an uncertain prior");
+  v("min_downsampled_points", c.min_downsampled_points, nullptr,
+    "sparse frames (below 10x this) keeping fewer points get smaller voxels, to voxel_size / 4 "
+    "(0: off)");
   v("threads", c.threads, "--threads", "Threads (1 for fair comparisons)");
   v.nested("registration", c.registration);
 }

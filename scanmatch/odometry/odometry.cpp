@@ -7,6 +7,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/odometry/adaptive.hpp"
 #include "scanmatch/registration/factors/ctf_fine.hpp"
 #include "scanmatch/registration/factors/ndt.hpp"
 
@@ -59,6 +60,11 @@ void check_config(const OdometryConfig& c) {
     throw Error("odometry: voxel sizes and min_range must not be negative");
   if (c.merge_threshold == 0) throw Error("odometry: merge_threshold must be at least 1");
   if (c.threads < 1) throw Error("odometry: threads must be at least 1");
+  if (!(c.max_step_ratio >= 1.0)) throw Error("odometry: max_step_ratio must be at least 1");
+  if (!(c.uncertain_ndt_scale >= 1.0) || !(c.uncertain_jump_scale >= 1.0))
+    throw Error("odometry: uncertain_ndt_scale and uncertain_jump_scale must be at least 1");
+  positive(c.prior_miss_distance, "prior_miss_distance");
+  positive(c.prior_miss_angle, "prior_miss_angle");
 }
 
 // Deskewing with the constant-velocity motion over the frame, into the sensor frame at the
@@ -111,7 +117,7 @@ PointCloud Odometry::preprocess(const PointCloud& frame) const {
   if (deskew)
     for (float t : frame.time)
       if (std::isfinite(t)) max_time = std::max(max_time, t);
-  const FrameMotion motion(velocity_, frame_period_, max_time, 0.5 * frame_period_);
+  const FrameMotion motion(adaptive_.prior.motion, frame_period_, max_time, 0.5 * frame_period_);
   PointCloud kept;
   kept.reserve(frame.size());
   for (std::size_t i = 0; i < frame.size(); ++i) {
@@ -126,7 +132,7 @@ PointCloud Odometry::preprocess(const PointCloud& frame) const {
     if (frame.has_ring()) kept.ring.push_back(frame.ring[i]);
     if (frame.has_intensity()) kept.intensity.push_back(frame.intensity[i]);
   }
-  return config_.voxel_size > 0.0 ? voxel_downsample(kept, config_.voxel_size) : kept;
+  return adaptive_downsample(kept, frame.size(), config_);
 }
 
 Pose Odometry::register_baseline(const PointCloud& down, const Pose& predicted) {
@@ -138,7 +144,7 @@ Pose Odometry::register_baseline(const PointCloud& down, const Pose& predicted) 
   const auto start = Clock::now();
   RegistrationOptions o = config_.registration;
   o.method = config_.method;
-  const RegistrationResult r = register_clouds(down, previous_, o, velocity_);
+  const RegistrationResult r = register_clouds(down, previous_, o, adaptive_.prior.motion);
   stats_.coarse_ms = ms_since(start);
   stats_.iterations = r.iterations;
   stats_.condition_number = r.condition_number;
@@ -164,10 +170,16 @@ Pose Odometry::register_ctf(const PointCloud& down, const PointCloud& coarse_sou
     solver.final_linearization = false;
     NdtFactor factor{coarse_source, previous_ndt_, config_.ndt_neighbours, ndt_d1_, ndt_d2_};
     if (config_.ndt_neighbours == 1) factor.hints.resize(coarse_source.size());
-    const RegistrationResult coarse = optimize(factor, velocity_, solver);
+    const RegistrationResult coarse = optimize(factor, adaptive_.prior.motion, solver);
     stats_.iterations = coarse.iterations;
     stats_.condition_number = coarse.condition_number;
     if (coarse.inliers >= kMinimumPoints) estimate = pose_ * coarse.transform;
+    if (adaptive_.prior.uncertain)  // first frames, irregular steps: check other starts
+      estimate =
+          pose_ * coarse_multi_start(
+                      coarse_source, previous_, previous_ndt_,
+                      coarse.inliers >= kMinimumPoints ? coarse.transform : adaptive_.prior.motion,
+                      adaptive_.prior.motion, solver, config_, stats_.iterations);
   }
   stats_.coarse_ms = ms_since(coarse_start);
 
@@ -213,15 +225,17 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   stats_ = FrameStats{};
   stats_.points_in = frame.size();
   if (frames_ == 0) timed_frames_ = frame.has_time();
+  const double step = frames_ > 0 ? timestamp - last_timestamp_ : 0.0;
   if (frames_ > 0 && timestamp > last_timestamp_) frame_period_ = timestamp - last_timestamp_;
   last_timestamp_ = timestamp;
+  adaptive_.prior = predict_motion(adaptive_, velocity_, step, frames_, config_);
   PointCloud down = frame.fields_consistent()
                         ? preprocess(frame)
                         : PointCloud{};  // inconsistent fields: treated as an empty frame
   stats_.points_downsampled = down.size();
   stats_.preprocess_ms = ms_since(start);
 
-  const Pose predicted = pose_ * velocity_;
+  const Pose predicted = pose_ * adaptive_.prior.motion;
   const bool ctf = config_.method == "ctf-icp";
   // The NDT stage works on a sparser cloud: it only has to bring the fine stage into its basin.
   const PointCloud coarse = ctf && config_.coarse_voxel_size > config_.voxel_size
@@ -241,8 +255,9 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
   // Never let a failed solve poison the trajectory: a result far from the motion prior (or not
   // finite) is replaced by the prior.
   const Pose jump = predicted.inverse() * estimate;
-  if (!to_matrix(estimate).allFinite() || jump.translation().norm() > config_.max_jump ||
-      rotation_angle(jump) > config_.max_jump_angle) {
+  const double gate = jump_gate_scale(adaptive_, config_);
+  if (!to_matrix(estimate).allFinite() || jump.translation().norm() > gate * config_.max_jump ||
+      rotation_angle(jump) > gate * config_.max_jump_angle) {
     stats_.bridged = true;
     estimate = predicted;
   }
@@ -274,6 +289,9 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
     stats_.map_ms = ms_since(map_start);
   }
   // A bridged frame keeps the last good velocity rather than one derived from the prior itself.
+  if (frames_ > 0)
+    record_motion(adaptive_, orthonormalized(pose_.inverse() * estimate), stats_.bridged, step,
+                  config_);
   if (!stats_.bridged && config_.constant_velocity)
     velocity_ = frames_ > 0 ? orthonormalized(pose_.inverse() * estimate) : Pose::Identity();
   pose_ = estimate;

@@ -19,6 +19,7 @@
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"
+#include "scanmatch/odometry/adaptive_state.hpp"
 #include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
@@ -67,6 +68,20 @@ struct OdometryConfig {
   double deskew_min_rotation = 0.002;    ///< rad per frame
   double max_jump = 1.0;        ///< m: a result farther than this from the prior is rejected
   double max_jump_angle = 1.0;  ///< rad: likewise for rotation (hand-held motion turns fast)
+  // Sparse and irregular frames (odometry/adaptive.hpp; docs/odometry.md "Sparse keyframes").
+  /// Scale the constant-velocity prior by the ratio of the frame time steps.
+  bool time_scaled_prior = true;
+  double max_step_ratio = 4.0;  ///< time-step ratios beyond this (or its inverse) are uncertain
+  /// A frame whose estimate lies farther than this from its prior makes the next prior uncertain.
+  double prior_miss_distance = 0.2;  ///< m
+  double prior_miss_angle = 0.05;    ///< rad
+  /// ctf-icp, uncertain prior: try other coarse starts (identity, half and twice the prior).
+  bool uncertain_starts = true;
+  double uncertain_ndt_scale = 3.0;   ///< the other starts run first on this times ndt_resolution
+  double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
+  /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
+  /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
+  std::size_t min_downsampled_points = 1000;
   int threads = 1;
   RegistrationOptions registration;  ///< parameters of the frame-to-frame baselines
 };
@@ -125,6 +140,7 @@ class Odometry {
   Eigen::Vector3d last_prune_ = Eigen::Vector3d::Zero();  ///< where the map was last pruned
   std::size_t frames_ = 0;
   bool timed_frames_ = false;  ///< the first frame had point times: poses are mid-frame internally
+  AdaptiveState adaptive_;     ///< sparse and irregular frames (adaptive.hpp)
   FrameStats stats_;
 };
 

@@ -1,0 +1,252 @@
+// Sparse keyframes: the simulator's keyframe output (exact ground truth of the kept frames) and
+// CTF-ICP with default options on keyframe sequences (a spinning 64-ring sensor every 5th frame,
+// Livox Avia keyframes 0.75 m and 0.5-1 m apart with 4000 points and no point time), against the
+// adaptive rules of scanmatch/odometry/adaptive.hpp.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "scanmatch/eval/metrics.hpp"
+#include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/io/cloud_io.hpp"
+#include "scanmatch/odometry/adaptive.hpp"
+#include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/sim/keyframes.hpp"
+#include "test_helpers.hpp"
+
+using namespace scanmatch;
+using scanmatch::testing::run_cli;
+using scanmatch::testing::TempDir;
+
+namespace {
+
+bool sanitized() {
+  return std::getenv("SCANMATCH_SANITIZED") != nullptr;
+}
+
+struct Keyframes {
+  std::vector<PointCloud> frames;
+  std::vector<double> times;
+  std::vector<Pose> truth;
+  std::vector<std::size_t> indices;
+};
+
+Keyframes simulate(sim::SimOptions options, const sim::KeyframeOptions& keyframes) {
+  const sim::Simulator simulator(options);
+  Keyframes k;
+  k.indices = sim::select_keyframes(simulator, keyframes);
+  for (std::size_t i : k.indices) {
+    k.frames.push_back(sim::thin_keyframe(simulator.frame(i), keyframes, i));
+    k.times.push_back(simulator.frame_time(i));
+    k.truth.push_back(simulator.pose(i));
+  }
+  return k;
+}
+
+AteResult track(const Keyframes& k, const OdometryConfig& config = {}) {
+  Odometry odometry(config);
+  std::vector<Pose> poses;
+  for (std::size_t i = 0; i < k.frames.size(); ++i)
+    poses.push_back(odometry.register_frame(k.frames[i], k.times[i]));
+  return compute_ate(k.truth, poses);
+}
+
+// The state before the adaptive rules: constant velocity over whatever step, one coarse start,
+// the fixed gate, the fixed voxel.
+OdometryConfig without_adaptive_rules() {
+  OdometryConfig c;
+  c.time_scaled_prior = false;
+  c.uncertain_starts = false;
+  c.uncertain_jump_scale = 1.0;
+  c.min_downsampled_points = 0;
+  return c;
+}
+
+// Avia keyframes like a FAST-LIO keyframe folder: 4000 points, no point time, no distortion.
+sim::SimOptions avia(const std::string& preset, std::size_t frames) {
+  sim::SimOptions o;
+  o.preset = preset;
+  o.sensor = "avia";
+  o.frames = frames;
+  o.motion_distortion = false;
+  return o;
+}
+
+sim::KeyframeOptions fast_lio_like(double distance, double distance_max) {
+  sim::KeyframeOptions k;
+  k.distance = distance;
+  k.distance_max = distance_max;
+  k.max_points = 4000;
+  k.point_time = false;
+  return k;
+}
+
+}  // namespace
+
+TEST(SimulatorKeyframes, KeptFramesKeepTheirExactGroundTruthAndTimes) {
+  sim::SimOptions o;
+  o.preset = "dynamic-outdoor-fast";
+  o.frames = 200;
+  const sim::Simulator simulator(o);
+  sim::KeyframeOptions every;
+  every.every = 5;
+  const std::vector<std::size_t> fifth = sim::select_keyframes(simulator, every);
+  ASSERT_EQ(fifth.size(), 40u);
+  for (std::size_t k = 0; k < fifth.size(); ++k) EXPECT_EQ(fifth[k], 5 * k);
+
+  // Irregular distances: every step at least the minimum, the thresholds spread over the range.
+  const sim::KeyframeOptions irregular = fast_lio_like(0.5, 1.0);
+  const std::vector<std::size_t> kept = sim::select_keyframes(simulator, irregular);
+  ASSERT_GT(kept.size(), 20u);
+  EXPECT_EQ(kept.front(), 0u);
+  double shortest = 1e9, longest = 0.0;
+  for (std::size_t k = 1; k < kept.size(); ++k) {
+    const double step =
+        (simulator.pose(kept[k]).translation() - simulator.pose(kept[k - 1]).translation()).norm();
+    // The frame before a kept one had not yet moved the threshold (<= 1 m).
+    const double before =
+        (simulator.pose(kept[k] - 1).translation() - simulator.pose(kept[k - 1]).translation())
+            .norm();
+    EXPECT_GE(step, 0.5);
+    EXPECT_LT(before, 1.0);
+    shortest = std::min(shortest, step);
+    longest = std::max(longest, step);
+  }
+  EXPECT_GT(longest - shortest, 0.2);
+
+  // Thinning: a subset of the frame's points, no time field, the same for the same seed.
+  const PointCloud full = simulator.frame(10);
+  const PointCloud thin = sim::thin_keyframe(full, irregular, 10);
+  ASSERT_EQ(thin.size(), 4000u);
+  EXPECT_FALSE(thin.has_time());
+  EXPECT_TRUE(thin.has_intensity());
+  EXPECT_EQ(sim::thin_keyframe(full, irregular, 10).points, thin.points);
+  std::size_t found = 0;
+  for (std::size_t i = 0, j = 0; i < thin.size() && j < full.size(); ++j)
+    if (full.points[j] == thin.points[i]) ++found, ++i;
+  EXPECT_EQ(found, thin.size());  // in the original order, each one of the frame's points
+}
+
+TEST(SimulatorKeyframes, TheCliWritesAKeyframeFolderThatOdometryTracksWithDefaults) {
+  TempDir dir;
+  const std::string data = dir.file("kf"), run = dir.file("run");
+  auto r = run_cli(
+      "simulate dynamic-outdoor --sensor avia --frames 600 --keyframe-distance 0.5 "
+      "--keyframe-distance-max 1.0 --max-points 4000 --no-point-time --no-motion-distortion "
+      "--quiet --out " +
+      data);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json info = nlohmann::json::parse(std::ifstream(data + "/dataset.json"));
+  const std::size_t frames = info["frames"];
+  ASSERT_GT(frames, 40u);
+  EXPECT_EQ(info["keyframes"]["frame_indices"].size(), frames);
+  const std::size_t first = info["keyframes"]["frame_indices"][1];
+  char name[32];
+  std::snprintf(name, sizeof name, "/frames/%06zu.pcd", first);
+  const PointCloud cloud = read_cloud(data + name);
+  EXPECT_EQ(cloud.size(), 4000u);
+  EXPECT_FALSE(cloud.has_time());
+
+  r = run_cli("odometry " + data + " --method ctf-icp --quiet --out " + run);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(run + "/summary.json"));
+  EXPECT_EQ(summary["frames"], frames);
+  // Measured 0.048 % of the 49 m path (4.7 % before the adaptive rules).
+  EXPECT_LT(summary["ate"]["rmse_percent_of_path"].get<double>(), 0.1);
+
+  r = run_cli("simulate dynamic-outdoor --keyframe-distance 1 --keyframe-distance-max 0.5 --out " +
+              dir.file("bad"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("--keyframe-distance-max"), std::string::npos) << r.output;
+}
+
+TEST(Keyframes, ASpinning64RingSensorEveryFifthFrameIsTracked) {
+  // campus-os1 every 5th frame: 64 rings 0.5 s apart, the car 3 m from one to the next.
+  sim::SimOptions o;
+  o.preset = "campus-os1";
+  o.frames = sanitized() ? 50 : 150;
+  sim::KeyframeOptions every;
+  every.every = 5;
+  const Keyframes k = simulate(o, every);
+  const AteResult ate = track(k);
+  // Measured 1.18 % of the 84 m (the first 30 keyframes, the car speeding up to 6 m/s).
+  EXPECT_LT(ate.rmse_percent_of_path, 2.5);
+  // Without the adaptive rules the constant-velocity prior sticks at the first slow steps: 46 %.
+  if (!sanitized()) {
+    EXPECT_GT(track(k, without_adaptive_rules()).rmse_percent_of_path, 10.0);
+  }
+}
+
+TEST(Keyframes, AviaKeyframesWithoutPointTimeAreTracked) {
+  // dynamic-outdoor-fast with an Avia, a keyframe every 0.75 m: 4000 points, no point time.
+  const Keyframes k =
+      simulate(avia("dynamic-outdoor-fast", sanitized() ? 40 : 150), fast_lio_like(0.75, 0.0));
+  ASSERT_GT(k.frames.size(), sanitized() ? 15u : 60u);
+  const AteResult ate = track(k);
+  // Measured 0.079 % of the 64 m (13.9 % before the adaptive rules).
+  EXPECT_LT(ate.rmse_percent_of_path, sanitized() ? 1.0 : 0.16);
+  EXPECT_GT(track(k, without_adaptive_rules()).rmse_percent_of_path, 2.0);
+}
+
+TEST(AdaptiveRules, ThePriorScalesWithTheTimeStepAndIsUncertainWhenTheStepIsUnknown) {
+  OdometryConfig c;
+  AdaptiveState state;
+  state.velocity_period = 0.1;
+  const Pose velocity = from_xyz_rpy(0.5, 0.1, 0.0, 0.0, 0.0, 0.05);
+  // Regular steps (jitter included): the last motion itself, certain.
+  MotionPrior p = predict_motion(state, velocity, 0.1 + 1e-4, 5, c);
+  EXPECT_FALSE(p.uncertain);
+  EXPECT_TRUE(p.motion.isApprox(velocity, 0.0));
+  // Twice the step: the same motion twice (constant twist).
+  p = predict_motion(state, velocity, 0.2, 5, c);
+  EXPECT_FALSE(p.uncertain);
+  const Pose twice = velocity * velocity;
+  EXPECT_NEAR((p.motion.translation() - twice.translation()).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(rotation_angle(p.motion), 0.1, 1e-9);
+  // A gap of 10 steps: scaled by max_step_ratio at most, and uncertain.
+  p = predict_motion(state, velocity, 1.0, 5, c);
+  EXPECT_TRUE(p.uncertain);
+  EXPECT_NEAR(rotation_angle(p.motion), 0.05 * c.max_step_ratio, 1e-9);
+  // No increasing stamps; the first registered frame; after a bridged frame: uncertain.
+  EXPECT_TRUE(predict_motion(state, velocity, 0.0, 5, c).uncertain);
+  EXPECT_TRUE(predict_motion(state, velocity, 0.1, 1, c).uncertain);
+  AdaptiveState bridged = state;
+  record_motion(bridged, velocity, true, 0.1, c);
+  EXPECT_TRUE(predict_motion(bridged, velocity, 0.1, 5, c).uncertain);
+  EXPECT_DOUBLE_EQ(jump_gate_scale(AdaptiveState{}, c), 1.0);
+  // An estimate far from its prior (irregular steps without stamps) makes the next one uncertain.
+  AdaptiveState missed = state;
+  missed.prior = predict_motion(state, velocity, 0.1, 5, c);
+  record_motion(missed, from_xyz_rpy(1.0, 0.1, 0.0, 0.0, 0.0, 0.05), false, 0.1, c);
+  missed.prior = predict_motion(missed, velocity, 0.1, 5, c);
+  EXPECT_TRUE(missed.prior.uncertain);
+  EXPECT_DOUBLE_EQ(jump_gate_scale(missed, c), c.uncertain_jump_scale);
+}
+
+TEST(AdaptiveRules, ASparseFrameKeepsMorePointsADenseOneIsUnchanged) {
+  OdometryConfig c;
+  PointCloud sparse, dense;
+  // 1500 points on a 3 m x 3 m wall: 0.25 m voxels keep at most 144.
+  for (int i = 0; i < 1500; ++i)
+    sparse.points.emplace_back(5.0f, -1.5f + 3.0f * float(i % 39) / 39.0f,
+                               -1.5f + 3.0f * float(i / 39) / 39.0f);
+  const PointCloud more = adaptive_downsample(sparse, sparse.size(), c);
+  EXPECT_GT(more.size(), 4 * voxel_downsample(sparse, c.voxel_size).size());
+  EXPECT_LE(more.size(), sparse.size());
+  // A frame delivered dense (10x the floor) that sees only a near wall keeps the plain filter.
+  PointCloud wall;
+  for (int i = 0; i < 10000; ++i)
+    wall.points.emplace_back(1.0f, -1.0f + 2.0f * float(i % 100) / 100.0f,
+                             -1.0f + 2.0f * float(i / 100) / 100.0f);
+  EXPECT_EQ(adaptive_downsample(wall, wall.size(), c).points,
+            voxel_downsample(wall, c.voxel_size).points);
+  // 40 x 40 m of ground every 0.1 m: 25600 voxels, more than enough.
+  for (int i = 0; i < 400; ++i)
+    for (int j = 0; j < 400; ++j)
+      dense.points.emplace_back(-20.0f + 0.1f * i, -20.0f + 0.1f * j, -1.0f);
+  EXPECT_EQ(adaptive_downsample(dense, dense.size(), c).points,
+            voxel_downsample(dense, c.voxel_size).points);
+}
