@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <vector>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
@@ -196,6 +197,41 @@ TEST(Odometry, TheFivePointRuleAndTheMergeMatchBatchStatistics) {
   EXPECT_EQ(v.count, 8u);
   EXPECT_LT((v.mean - mean).norm(), 1e-9);
   EXPECT_LT((v.covariance - covariance).norm(), 1e-9);
+}
+
+// The hinted find (the registration's per-point voxel memory) must give find's answer as points
+// move within and across voxels, including voxels that are absent or below min_points.
+TEST(Odometry, HintedVoxelLookupAgreesWithThePlainOne) {
+  GaussianVoxelMapOptions options;
+  options.voxel_size = 0.5;
+  options.merge_threshold = 1;
+  GaussianVoxelMap map(options);
+  std::srand(7);
+  const auto uniform = [] { return static_cast<double>(std::rand()) / RAND_MAX; };
+  PointCloud cloud;
+  for (int i = 0; i < 4000; ++i)  // sparse enough that some voxels stay below 5 points
+    cloud.points.emplace_back(static_cast<float>(4 * uniform()), static_cast<float>(4 * uniform()),
+                              static_cast<float>(uniform()));
+  map.insert(cloud);
+  std::vector<Eigen::Vector3d> queries;
+  for (int i = 0; i < 500; ++i)
+    queries.emplace_back(5 * uniform() - 0.5, 5 * uniform() - 0.5, 1.5 * uniform() - 0.25);
+  std::vector<VoxelHint> hints(queries.size());
+  int moved = 0, found = 0;
+  for (int round = 0; round < 6; ++round) {
+    const Eigen::Vector3d shift(0.07 * round, -0.05 * round, 0.03 * round);
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+      const Eigen::Vector3d p = queries[i] + shift;
+      const VoxelKey before = hints[i].key;
+      const GaussianVoxel* hinted = map.find(p, hints[i]);
+      ASSERT_EQ(hinted, map.find(p)) << "query " << i << " round " << round;
+      moved += round > 0 && !(hints[i].key == before);
+      found += hinted != nullptr;
+    }
+  }
+  EXPECT_GT(moved, 500);  // the rounds did cross voxel faces
+  EXPECT_GT(found, 500);
+  EXPECT_LT(found, 6 * 500);
 }
 
 TEST(Odometry, BadFramesAreBridgedNeverFatal) {

@@ -54,6 +54,12 @@ std::size_t GaussianVoxelMap::lookup_or_create(const VoxelKey& index) {
   return voxels_.size() - 1;
 }
 
+void GaussianVoxelMap::reserve(std::size_t voxels) {
+  voxels_.reserve(voxels);
+  indices_.reserve(voxels);
+  if (2 * voxels > table_.size()) rebuild_table(voxels);
+}
+
 void GaussianVoxelMap::clear() {
   voxels_.clear();
   indices_.clear();

@@ -78,6 +78,8 @@ class GaussianVoxelMap {
   void flush();
   /// Removes every voxel but keeps the allocations (a map rebuilt every frame).
   void clear();
+  /// Room for this many voxels without reallocating.
+  void reserve(std::size_t voxels);
   /// Drops voxels whose mean is farther than `radius` from `center` (bounded map memory).
   std::size_t remove_far(const Eigen::Vector3d& center, double radius);
 
