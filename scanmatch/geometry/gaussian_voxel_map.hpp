@@ -27,17 +27,17 @@ struct alignas(64) GaussianVoxel {
   float flatness = 1.0f;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< smallest eigenvector
-  /// Only when the map's options ask for them (NDT, VGICP); eigenvalues clamped to >= 1e-3 of
-  /// the largest.
-  Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d regularized_covariance = Eigen::Matrix3d::Identity();
-  // Cold: the statistics and the points waiting to be merged.
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< population covariance
-  /// Points waiting to be merged (sums relative to the voxel's corner for precision).
+  // Next (the lines an insert touches after the hot one): the points waiting to be merged, sums
+  // relative to the voxel's corner for precision.
   std::uint32_t pending = 0;
   std::uint64_t last_insert = 0;  ///< which insert() call last touched the voxel
   Eigen::Vector3d pending_sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d pending_outer = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< population covariance
+  /// Only when the map's options ask for them (NDT, VGICP); eigenvalues clamped to >= 1e-3 of
+  /// the largest.
+  Eigen::Matrix3d regularized_information = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d regularized_covariance = Eigen::Matrix3d::Identity();
 };
 
 /// The CTF-ICP planar information (Q diag(1/eps, 1, 1) Q^T, the covariance's eigenvalues
