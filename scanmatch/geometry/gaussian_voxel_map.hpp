@@ -101,6 +101,24 @@ class GaussianVoxelMap {
     const GaussianVoxel& v = voxels_[static_cast<std::size_t>(hint.slot)];
     return v.count >= options_.min_points ? &v : nullptr;
   }
+  /// For a loop over points i with hints (find(position_of(i), hints[i])): at point i, resolves
+  /// the hint of point i + kNear and starts loading its voxel, and starts the hash probe of point
+  /// i + kFar, so that the loop's memory reads overlap instead of waiting in turn. Results do not
+  /// change. `position_of(j)` is point j's position in the map frame.
+  template <typename PositionOf>
+  void prefetch_ahead(std::size_t i, std::size_t end, std::span<VoxelHint> hints,
+                      PositionOf&& position_of) const {
+    constexpr std::size_t kNear = 8, kFar = 16;
+    if (table_.empty()) return;
+    if (i + kFar < end && hints[i + kFar].slot == VoxelHint::kUnknown)
+      __builtin_prefetch(
+          &table_[VoxelKeyHash{}(index_of(position_of(i + kFar))) & (table_.size() - 1)]);
+    if (i + kNear < end) {
+      VoxelHint& ahead = hints[i + kNear];
+      if (ahead.slot == VoxelHint::kUnknown) find(position_of(i + kNear), ahead);
+      if (ahead.slot >= 0) __builtin_prefetch(&voxels_[static_cast<std::size_t>(ahead.slot)]);
+    }
+  }
   /// Calls f(voxel) for the usable voxels among p's voxel and its 6 (neighbours = 7) or 26
   /// (neighbours = 27) neighbours; neighbours = 1 is p's voxel only.
   template <typename F>

@@ -45,6 +45,9 @@ struct CtfFineFactor {
       if (hints.empty()) {
         count = map.gather_neighbours(x, neighbours, found);
       } else {
+        map.prefetch_ahead(i, end, hints, [&](std::size_t j) {
+          return Eigen::Vector3d(R * source.points[j].cast<double>() + t);
+        });
         found[0] = map.find(x, hints[i]);
         count = found[0] != nullptr;
       }
