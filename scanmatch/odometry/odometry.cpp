@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
@@ -117,20 +118,24 @@ PointCloud Odometry::preprocess(const PointCloud& frame) const {
   if (deskew)
     for (float t : frame.time)
       if (std::isfinite(t)) max_time = std::max(max_time, t);
-  const FrameMotion motion(adaptive_.prior.motion, frame_period_, max_time, 0.5 * frame_period_);
+  std::optional<FrameMotion> motion;
+  if (deskew) motion.emplace(adaptive_.prior.motion, frame_period_, max_time, 0.5 * frame_period_);
+  // Rings and intensities feed the feature methods (loam); ctf-icp reads only the points, and
+  // times are used up by the deskew.
+  const bool keep_ring = frame.has_ring() && config_.method != "ctf-icp";
+  const bool keep_intensity = frame.has_intensity() && config_.method != "ctf-icp";
   PointCloud kept;
-  kept.reserve(frame.size());
+  kept.points.reserve(frame.size());
   for (std::size_t i = 0; i < frame.size(); ++i) {
     const Point& p = frame.points[i];
     const double r2 = p.squaredNorm();
     if (!p.allFinite() || r2 < min2 || r2 > max2) continue;
     if (deskew && std::isfinite(frame.time[i]))
-      kept.points.push_back(motion.apply(p, frame.time[i]));
+      kept.points.push_back(motion->apply(p, frame.time[i]));
     else
       kept.points.push_back(p);
-    // Rings and intensities feed the feature methods (loam); times are used up by the deskew.
-    if (frame.has_ring()) kept.ring.push_back(frame.ring[i]);
-    if (frame.has_intensity()) kept.intensity.push_back(frame.intensity[i]);
+    if (keep_ring) kept.ring.push_back(frame.ring[i]);
+    if (keep_intensity) kept.intensity.push_back(frame.intensity[i]);
   }
   return adaptive_downsample(kept, frame.size(), config_);
 }
