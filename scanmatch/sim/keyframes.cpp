@@ -2,14 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numeric>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/core/progress.hpp"
-#include "scanmatch/io/cloud_io.hpp"
-#include "scanmatch/io/file_util.hpp"
 #include "scanmatch/sim/random.hpp"
 
 namespace scanmatch::sim {
@@ -81,60 +77,26 @@ PointCloud thin_keyframe(PointCloud cloud, const KeyframeOptions& o, std::size_t
 
 void write_keyframe_dataset(const Simulator& sim, const KeyframeOptions& o,
                             const std::string& folder, bool quiet) {
-  namespace fs = std::filesystem;
   if (sim.sensor().is_2d())
     throw Error("simulate: keyframe options are for 3D sensors ('" + sim.sensor().name +
                 "' is 2D)");
-  const std::vector<std::size_t> kept = select_keyframes(sim, o);
-  std::error_code ec;
-  fs::create_directories(fs::path(folder) / "frames", ec);
-  if (ec) throw Error(folder + ": cannot create the folder: " + ec.message());
-  ProgressReporter progress("simulate " + sim.preset().name + " keyframes", kept.size(), "frames",
-                            quiet);
-  TrajectoryWriter kitti((fs::path(folder) / "poses_gt.txt").string(), TrajectoryFormat::kKitti);
-  TrajectoryWriter tum((fs::path(folder) / "poses_gt_tum.txt").string(), TrajectoryFormat::kTum);
-  std::string times;
-  std::size_t points = 0;
-  double path = 0.0;
-  for (std::size_t k = 0; k < kept.size(); ++k) {
-    const std::size_t i = kept[k];
-    const PointCloud cloud = thin_keyframe(sim.frame(i), o, i);
-    points += cloud.size();
-    char name[32];
-    std::snprintf(name, sizeof name, "%06zu.pcd", i);
-    write_cloud((fs::path(folder) / "frames" / name).string(), cloud);
-    kitti.write(sim.pose(i), sim.frame_time(i));
-    tum.write(sim.pose(i), sim.frame_time(i));
-    char line[64];
-    std::snprintf(line, sizeof line, "%.6f\n", sim.frame_time(i));
-    times += line;
-    if (k > 0) path += (sim.pose(i).translation() - sim.pose(kept[k - 1]).translation()).norm();
-    progress.update(k + 1);
-  }
-  progress.finish();
-  write_file_atomic((fs::path(folder) / "times.txt").string(), times);
-  const nlohmann::ordered_json info = {{"preset", sim.preset().name},
-                                       {"scene", sim.preset().scene},
-                                       {"sensor", sim.sensor().name},
-                                       {"rate_hz", sim.sensor().rate_hz},
-                                       {"seed", sim.options().seed},
-                                       {"frames", kept.size()},
-                                       {"path_length_m", path},
-                                       {"motion_distortion", sim.options().motion_distortion},
-                                       {"noise", sim.options().noise},
-                                       {"points", points},
-                                       {"description", sim.preset().description},
-                                       {"keyframes",
-                                        {{"source_frames", sim.size()},
-                                         {"every", o.every},
-                                         {"distance_m", o.distance},
-                                         {"distance_max_m", o.distance_max},
-                                         {"angle_rad", o.angle},
-                                         {"max_points", o.max_points},
-                                         {"point_time", o.point_time},
-                                         {"seed", o.seed},
-                                         {"frame_indices", kept}}}};
-  write_file_atomic((fs::path(folder) / "dataset.json").string(), info.dump(2) + "\n");
+  DatasetSelection selection;
+  selection.frames = select_keyframes(sim, o);
+  selection.prepare = [&](PointCloud cloud, std::size_t i) {
+    return thin_keyframe(std::move(cloud), o, i);
+  };
+  selection.describe = [&](nlohmann::ordered_json& info) {
+    info["keyframes"] = {{"source_frames", sim.size()},
+                         {"every", o.every},
+                         {"distance_m", o.distance},
+                         {"distance_max_m", o.distance_max},
+                         {"angle_rad", o.angle},
+                         {"max_points", o.max_points},
+                         {"point_time", o.point_time},
+                         {"seed", o.seed},
+                         {"frame_indices", selection.frames}};
+  };
+  write_dataset(sim, folder, quiet, selection);
 }
 
 }  // namespace scanmatch::sim

@@ -206,24 +206,32 @@ LaserScan2D Simulator::scan_2d(std::size_t i) const {
   return scan;
 }
 
-void write_dataset(const Simulator& sim, const std::string& folder, bool quiet) {
+void write_dataset(const Simulator& sim, const std::string& folder, bool quiet,
+                   const DatasetSelection& selection) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(folder, ec);
   if (ec) throw Error(folder + ": cannot create the folder: " + ec.message());
   const bool planar = sim.sensor().is_2d();
   if (!planar) fs::create_directories(fs::path(folder) / "frames", ec);
-  ProgressReporter progress("simulate " + sim.preset().name, sim.size(), "frames", quiet);
+  std::vector<std::size_t> frames = selection.frames;
+  if (frames.empty())
+    for (std::size_t i = 0; i < sim.size(); ++i) frames.push_back(i);
+  ProgressReporter progress("simulate " + sim.preset().name, frames.size(), "frames", quiet);
   TrajectoryWriter kitti((fs::path(folder) / "poses_gt.txt").string(), TrajectoryFormat::kKitti);
   TrajectoryWriter tum((fs::path(folder) / "poses_gt_tum.txt").string(), TrajectoryFormat::kTum);
   std::string times;
   CarmenLog log;
   std::size_t points = 0;
-  for (std::size_t i = 0; i < sim.size(); ++i) {
+  double path = 0.0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const std::size_t i = frames[k];
+    if (i >= sim.size()) throw Error("simulate: frame " + std::to_string(i) + " does not exist");
     if (planar) {
       log.scans.push_back(sim.scan_2d(i));
     } else {
-      const PointCloud cloud = sim.frame(i);
+      const PointCloud cloud =
+          selection.prepare ? selection.prepare(sim.frame(i), i) : sim.frame(i);
       points += cloud.size();
       char name[32];
       std::snprintf(name, sizeof name, "%06zu.pcd", i);
@@ -234,22 +242,25 @@ void write_dataset(const Simulator& sim, const std::string& folder, bool quiet) 
     char line[64];
     std::snprintf(line, sizeof line, "%.6f\n", sim.frame_time(i));
     times += line;
-    progress.update(i + 1);
+    if (k > 0) path += (sim.pose(i).translation() - sim.pose(frames[k - 1]).translation()).norm();
+    progress.update(k + 1);
   }
   progress.finish();
   if (planar) write_carmen_log((fs::path(folder) / "scans.log").string(), log);
   write_file_atomic((fs::path(folder) / "times.txt").string(), times);
-  const nlohmann::ordered_json info = {{"preset", sim.preset().name},
-                                       {"scene", sim.preset().scene},
-                                       {"sensor", sim.sensor().name},
-                                       {"rate_hz", sim.sensor().rate_hz},
-                                       {"seed", sim.options().seed},
-                                       {"frames", sim.size()},
-                                       {"path_length_m", sim.path_length()},
-                                       {"motion_distortion", sim.options().motion_distortion},
-                                       {"noise", sim.options().noise},
-                                       {"points", points},
-                                       {"description", sim.preset().description}};
+  nlohmann::ordered_json info = {
+      {"preset", sim.preset().name},
+      {"scene", sim.preset().scene},
+      {"sensor", sim.sensor().name},
+      {"rate_hz", sim.sensor().rate_hz},
+      {"seed", sim.options().seed},
+      {"frames", frames.size()},
+      {"path_length_m", selection.frames.empty() ? sim.path_length() : path},
+      {"motion_distortion", sim.options().motion_distortion},
+      {"noise", sim.options().noise},
+      {"points", points},
+      {"description", sim.preset().description}};
+  if (selection.describe) selection.describe(info);
   write_file_atomic((fs::path(folder) / "dataset.json").string(), info.dump(2) + "\n");
 }
 

@@ -3,7 +3,9 @@
 // ground truth, written as a data set or streamed as a SequenceSource (`sim:PRESET`).
 
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,9 +75,20 @@ class Simulator {
   Pose first_inverse_ = Pose::Identity();
 };
 
-/// Writes frames/NNNNNN.pcd (or scans.log for 2D), poses_gt.txt, poses_gt_tum.txt, times.txt and
-/// dataset.json into `folder` (created). Progress on a terminal unless `quiet`.
-void write_dataset(const Simulator& simulator, const std::string& folder, bool quiet);
+/// What write_dataset writes beyond the simulator's own frames.
+struct DatasetSelection {
+  std::vector<std::size_t> frames;  ///< frame indices, ascending (empty: every frame)
+  /// Applied to each 3D frame (with its index) before it is written; empty: as simulated.
+  std::function<PointCloud(PointCloud, std::size_t)> prepare;
+  /// Adds fields to dataset.json; empty: none.
+  std::function<void(nlohmann::ordered_json&)> describe;
+};
+
+/// Writes frames/NNNNNN.pcd (named by frame index; scans.log for 2D), poses_gt.txt,
+/// poses_gt_tum.txt, times.txt and dataset.json into `folder` (created). Progress on a terminal
+/// unless `quiet`.
+void write_dataset(const Simulator& simulator, const std::string& folder, bool quiet,
+                   const DatasetSelection& selection = {});
 
 /// `sim:PRESET` generates frames on the fly (options.preset is replaced by PRESET); anything else
 /// is opened with open_sequence_folder.
