@@ -128,6 +128,14 @@ class GaussianVoxelMap {
     for (int k = 0; k < count; ++k) f(*found[k]);
   }
 
+  /// gather_neighbours, or with a hint (one voxel per point only) the hinted find.
+  int gather_neighbours(const Eigen::Vector3d& p, int neighbours, const GaussianVoxel** out,
+                        VoxelHint* hint) const {
+    if (hint == nullptr) return gather_neighbours(p, neighbours, out);
+    out[0] = find(p, *hint);
+    return out[0] != nullptr;
+  }
+
   /// The same voxels as for_each_neighbour, written to `out` (room for `neighbours`, at most 27);
   /// returns how many. For hot loops: a plain loop over them inlines where a callback may not.
   int gather_neighbours(const Eigen::Vector3d& p, int neighbours, const GaussianVoxel** out) const {

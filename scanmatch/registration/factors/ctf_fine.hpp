@@ -41,16 +41,12 @@ struct CtfFineFactor {
     const GaussianVoxel* found[27];
     for (std::size_t i = begin; i < end; ++i) {
       const Eigen::Vector3d y = R * source.points[i].cast<double>(), x = y + t;
-      int count;
-      if (hints.empty()) {
-        count = map.gather_neighbours(x, neighbours, found);
-      } else {
+      if (!hints.empty())
         map.prefetch_ahead(i, end, hints, [&](std::size_t j) {
           return Eigen::Vector3d(R * source.points[j].cast<double>() + t);
         });
-        found[0] = map.find(x, hints[i]);
-        count = found[0] != nullptr;
-      }
+      const int count =
+          map.gather_neighbours(x, neighbours, found, hints.empty() ? nullptr : &hints[i]);
       for (int k = 0; k < count; ++k) {
         const GaussianVoxel& v = *found[k];
         if (v.flatness > max_flatness) continue;

@@ -43,13 +43,8 @@ struct NdtFactor {
     const GaussianVoxel* found[27];
     for (std::size_t i = begin; i < end; ++i) {
       const Eigen::Vector3d y = R * source.points[i].cast<double>(), x = y + t;
-      int count;
-      if (hints.empty()) {
-        count = target_map.gather_neighbours(x, neighbours, found);
-      } else {
-        found[0] = target_map.find(x, hints[i]);
-        count = found[0] != nullptr;
-      }
+      const int count =
+          target_map.gather_neighbours(x, neighbours, found, hints.empty() ? nullptr : &hints[i]);
       for (int k = 0; k < count; ++k) {
         const GaussianVoxel& v = *found[k];
         const Eigen::Vector3d r = x - v.mean;
