@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -14,6 +15,11 @@
 #include <cstdio>
 
 namespace scanmatch::testing {
+
+/// Under the sanitizers (scripts/test --sanitize) tests run on fewer frames.
+inline bool sanitized() {
+  return std::getenv("SCANMATCH_SANITIZED") != nullptr;
+}
 
 /// A fresh folder under the system temp dir, removed when the object goes away.
 class TempDir {

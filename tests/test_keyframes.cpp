@@ -19,13 +19,10 @@
 
 using namespace scanmatch;
 using scanmatch::testing::run_cli;
+using scanmatch::testing::sanitized;
 using scanmatch::testing::TempDir;
 
 namespace {
-
-bool sanitized() {
-  return std::getenv("SCANMATCH_SANITIZED") != nullptr;
-}
 
 struct Keyframes {
   std::vector<PointCloud> frames;

@@ -12,14 +12,12 @@
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/odometry/odometry.hpp"
 #include "scanmatch/sim/simulator.hpp"
+#include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::sanitized;
 
 namespace {
-
-bool sanitized() {
-  return std::getenv("SCANMATCH_SANITIZED") != nullptr;
-}
 
 struct Sequence {
   std::vector<PointCloud> frames;
