@@ -6,6 +6,7 @@
 
 #include "apps/commands.hpp"
 #include "scanmatch/benchmark/benchmark.hpp"
+#include "scanmatch/odometry/frame_odometry.hpp"
 
 namespace scanmatch::cli {
 
@@ -18,7 +19,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--sequence", o->sequences, "Sequence folders (with ground truth) to add");
   cmd->add_option("--method", o->methods,
                   "Methods (default: ctf-icp icp ndt gicp vgicp loam point-to-plane "
-                  "point-to-line)");
+                  "point-to-line; any of " +
+                      odometry_methods_with_peers() + ")");
   cmd->add_option("--frames", o->frames, "Frames per sequence (0: all)");
   cmd->add_option("--threads", o->threads, "Threads per method")->capture_default_str();
   cmd->add_flag("!--no-ablation", o->ablation, "Skip ctf-icp --no-fine and --no-map-update");

@@ -11,6 +11,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/odometry/config_io.hpp"
+#include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/run.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
@@ -97,7 +98,7 @@ void add_odometry_command(CLI::App& app) {
   cmd->add_option("--frames", c->frames, "Process at most this many frames (0: all)");
   cmd->add_option("--seed", c->seed, "Seed of sim:PRESET sequences")->capture_default_str();
   add_config_options(cmd, o);
-  cmd->get_option("--method")->description("One of: " + odometry_method_list());
+  cmd->get_option("--method")->description("One of: " + odometry_methods_with_peers());
   cmd->add_flag("--no-fine", c->no_fine, "Ablation: coarse NDT stage only");
   cmd->add_flag("--no-map-update", c->no_map_update,
                 "Ablation: fine stage against the previous frame, no global map");

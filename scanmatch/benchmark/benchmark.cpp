@@ -14,6 +14,7 @@
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/file_util.hpp"
+#include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch {
@@ -104,7 +105,7 @@ std::vector<BenchmarkVariant> benchmark_variants(const std::vector<std::string>&
     OdometryConfig c;
     c.method = method;
     c.threads = threads;
-    Odometry check(c);  // rejects unknown methods before any work
+    make_frame_odometry(c);  // rejects unknown methods (and peers not built) before any work
     v.push_back({method, c});
   }
   if (ablation && std::find(methods.begin(), methods.end(), "ctf-icp") != methods.end()) {

@@ -16,6 +16,7 @@
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/config_io.hpp"
+#include "scanmatch/odometry/frame_odometry.hpp"
 
 namespace scanmatch {
 namespace {
@@ -119,7 +120,7 @@ void write_ground_truth(const std::string& dir, const std::optional<Trajectory>&
 
 RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                         const RunOptions& options) {
-  Odometry odometry(config);
+  const std::unique_ptr<FrameOdometry> odometry = make_frame_odometry(config);
   const std::optional<Trajectory> truth = source.ground_truth();
   RunSummary summary;
   summary.method = config.method;
@@ -160,8 +161,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       summary.error = e.what();  // the run ends here, keeping what it finished
       break;
     }
-    const Pose pose = odometry.register_frame(frame.cloud, frame.timestamp);
-    const FrameStats& s = odometry.last_stats();
+    const Pose pose = odometry->register_frame(frame.cloud, frame.timestamp);
+    const FrameStats& s = odometry->last_stats();
     pipeline_ms += s.total_ms;
     if (s.bridged && summary.frames > 0) {
       ++summary.bridged_frames;
@@ -184,8 +185,11 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     }
     // A bridged frame has no registered points of its own (an empty frame leaves the previous
     // one in last_frame()); it would only add a copy or a guess to the map.
-    if (options.write_map && !s.bridged) {
-      map.add(odometry.last_frame(), odometry.world_from_map() * odometry.last_internal_pose());
+    Pose world_from_frame;
+    const PointCloud* map_frame =
+        options.write_map && !s.bridged ? odometry->last_map_frame(world_from_frame) : nullptr;
+    if (map_frame != nullptr) {
+      map.add(*map_frame, world_from_frame);
       if (options.map_export_radius > 0.0 && summary.frames % 50 == 0)
         map.keep_within(pose.translation(), options.map_export_radius);
     }

@@ -1,0 +1,89 @@
+#include "scanmatch/odometry/frame_odometry.hpp"
+
+#include <map>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/registration/methods.hpp"
+
+namespace scanmatch {
+namespace {
+
+struct Peer {
+  std::string description;
+  PeerFactory factory;
+};
+
+// Function-local so that peers registering from other translation units' static initialisers
+// find it constructed.
+std::map<std::string, Peer>& peers() {
+  static std::map<std::string, Peer> registry;
+  return registry;
+}
+
+/// Peers this project knows, with the CMake option that builds them.
+struct KnownPeer {
+  const char* name;
+  const char* option;
+};
+constexpr KnownPeer kKnownPeers[] = {
+    {"pcl-icp", "-DSCANMATCH_WITH_PCL=ON (Debian libpcl-dev: scripts/bootstrap --pcl)"},
+    {"pcl-ndt", "-DSCANMATCH_WITH_PCL=ON (Debian libpcl-dev: scripts/bootstrap --pcl)"},
+    {"pcl-gicp", "-DSCANMATCH_WITH_PCL=ON (Debian libpcl-dev: scripts/bootstrap --pcl)"},
+    {"kiss-icp", "-DSCANMATCH_WITH_KISS=ON (KISS-ICP installed; docs/benchmarks.md, Peers)"},
+};
+
+class OursOdometry final : public FrameOdometry {
+ public:
+  explicit OursOdometry(const OdometryConfig& config) : odometry_(config) {}
+  Pose register_frame(const PointCloud& frame, double timestamp) override {
+    return odometry_.register_frame(frame, timestamp);
+  }
+  const FrameStats& last_stats() const override { return odometry_.last_stats(); }
+  const PointCloud* last_map_frame(Pose& world_from_frame) const override {
+    world_from_frame = odometry_.world_from_map() * odometry_.last_internal_pose();
+    return &odometry_.last_frame();
+  }
+
+ private:
+  Odometry odometry_;
+};
+
+}  // namespace
+
+bool register_odometry_peer(const std::string& name, const std::string& description,
+                            PeerFactory factory) {
+  peers()[name] = Peer{description, std::move(factory)};
+  return true;
+}
+
+void check_odometry_method(const std::string& method) {
+  if (peers().count(method) > 0) return;
+  for (const KnownPeer& known : kKnownPeers)
+    if (method == known.name)
+      throw Error("odometry method '" + method +
+                  "' is a peer this build does not have: configure with " + known.option);
+  if (method != "ctf-icp" && !is_registration_method(method))
+    throw Error("unknown odometry method '" + method +
+                "' (valid: " + odometry_methods_with_peers() + ")");
+}
+
+std::unique_ptr<FrameOdometry> make_frame_odometry(const OdometryConfig& config) {
+  check_odometry_method(config.method);
+  if (const auto it = peers().find(config.method); it != peers().end())
+    return it->second.factory(config);
+  return std::make_unique<OursOdometry>(config);
+}
+
+std::vector<std::string> odometry_peers() {
+  std::vector<std::string> out;
+  for (const auto& [name, peer] : peers()) out.push_back(name + ": " + peer.description);
+  return out;
+}
+
+std::string odometry_methods_with_peers() {
+  std::string list = odometry_method_list();
+  for (const auto& [name, peer] : peers()) list += ", " + name;
+  return list;
+}
+
+}  // namespace scanmatch

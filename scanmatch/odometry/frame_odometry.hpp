@@ -1,0 +1,54 @@
+#pragma once
+// One interface for every odometry the runner and the benchmark drive: ours (Odometry: ctf-icp
+// and every registration method frame-to-frame) and the optional peers built beside it (PCL's
+// ICP, NDT and GICP, KISS-ICP; peers/ at the repository root, CMake options SCANMATCH_WITH_PCL
+// and SCANMATCH_WITH_KISS). A peer registers itself by name at start-up; the core library never
+// depends on one.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scanmatch/core/point_cloud.hpp"
+#include "scanmatch/core/se3.hpp"
+#include "scanmatch/odometry/odometry.hpp"
+
+namespace scanmatch {
+
+class FrameOdometry {
+ public:
+  virtual ~FrameOdometry() = default;
+  /// Registers the next frame (sensor frame, point times in s from the frame start when present);
+  /// returns its pose in the world frame of frame 0.
+  virtual Pose register_frame(const PointCloud& frame, double timestamp) = 0;
+  /// Timing and counts of the last frame (stages a method does not have stay 0).
+  virtual const FrameStats& last_stats() const = 0;
+  /// The last registered frame's points for the exported map, and the pose that places them in
+  /// the world frame; nullptr when the method keeps none.
+  virtual const PointCloud* last_map_frame(Pose& world_from_frame) const = 0;
+};
+
+/// Builds a peer from the run's configuration (the peer reads what applies to it: voxel_size,
+/// ranges, threads).
+using PeerFactory = std::function<std::unique_ptr<FrameOdometry>(const OdometryConfig&)>;
+
+/// Makes `name` a method of make_frame_odometry; peers call it from a static initialiser.
+/// Returns true (so it can initialise a namespace-scope constant).
+bool register_odometry_peer(const std::string& name, const std::string& description,
+                            PeerFactory factory);
+
+/// The odometry for config.method: a registered peer, or Odometry. Throws Error for an unknown
+/// method, naming the CMake option that builds a known peer this build lacks.
+std::unique_ptr<FrameOdometry> make_frame_odometry(const OdometryConfig& config);
+
+/// Throws what make_frame_odometry would for an unusable method, without building anything.
+void check_odometry_method(const std::string& method);
+
+/// Peers built into this program, "name: description" each.
+std::vector<std::string> odometry_peers();
+
+/// odometry_method_list() plus the peers built in.
+std::string odometry_methods_with_peers();
+
+}  // namespace scanmatch
