@@ -2,6 +2,9 @@
 // -DSCANMATCH_WITH_KISS=ON against an installed KISS-ICP C++ core (docs/benchmarks.md, Peers). Its
 // own pipeline and defaults, except the ranges and threads, which come from the run's
 // configuration, and the voxel size, max_range / 100 as KISS-ICP's own configuration derives it.
+// Written against the pipeline API with KissICP::pose() and RegisterFrame(points, times) (KISS-ICP
+// 1.x; older releases expose poses() instead). Not yet compiled: no KISS-ICP was installed where
+// it was written (docs/benchmarks.md, Peers).
 
 #include <algorithm>
 #include <chrono>
