@@ -81,7 +81,7 @@ struct OdometryConfig {
   double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
-  std::size_t min_downsampled_points = 1000;
+  std::uint32_t min_downsampled_points = 1000;
   int threads = 1;
   RegistrationOptions registration;  ///< parameters of the frame-to-frame baselines
 };
