@@ -2,9 +2,8 @@
 // -DSCANMATCH_WITH_KISS=ON against an installed KISS-ICP C++ core (docs/benchmarks.md, Peers). Its
 // own pipeline and defaults, except the ranges and threads, which come from the run's
 // configuration, and the voxel size, max_range / 100 as KISS-ICP's own configuration derives it.
-// Written against the pipeline API with KissICP::pose() and RegisterFrame(points, times) (KISS-ICP
-// 1.x; older releases expose poses() instead). Not yet compiled: no KISS-ICP was installed where
-// it was written (docs/benchmarks.md, Peers).
+// Written against the pipeline API with KissICP::pose(), delta() and RegisterFrame(points, times)
+// (KISS-ICP 1.x; older releases expose poses() instead).
 
 #include <algorithm>
 #include <chrono>
@@ -23,33 +22,32 @@ using Clock = std::chrono::steady_clock;
 
 class KissOdometry final : public FrameOdometry {
  public:
-  explicit KissOdometry(const OdometryConfig& config) : kiss_(kiss_config(config)) {}
+  explicit KissOdometry(const OdometryConfig& config)
+      : kiss_(kiss_config(config)), config_deskew_(config.deskew) {}
 
   Pose register_frame(const PointCloud& frame, double) override {
     const auto start = Clock::now();
     stats_ = FrameStats{};
     stats_.points_in = frame.size();
-    // KISS-ICP deskews with point times normalised to [0, 1] over the frame (0.5: mid-frame);
-    // frames without times get 0.5 everywhere, which leaves them as they are.
-    float max_time = 0.0f;
-    if (frame.has_time())
-      for (const float t : frame.time)
-        if (std::isfinite(t)) max_time = std::max(max_time, t);
+    // KISS-ICP rescales each frame's point times to [0, 1] itself and deskews to the scan's end;
+    // a frame without times goes in without (KISS then takes it as instantaneous).
     std::vector<Eigen::Vector3d> points;
     std::vector<double> times;
     points.reserve(frame.size());
-    times.reserve(frame.size());
+    const bool timed = frame.has_time() && config_deskew_;
     for (std::size_t i = 0; i < frame.size(); ++i) {
-      if (!frame.points[i].allFinite()) continue;
+      if (!frame.points[i].allFinite() || (timed && !std::isfinite(frame.time[i]))) continue;
       points.push_back(frame.points[i].cast<double>());
-      const bool timed = frame.has_time() && max_time > 0.0f && std::isfinite(frame.time[i]);
-      times.push_back(timed ? frame.time[i] / max_time : 0.5);
+      if (timed) times.push_back(frame.time[i]);
     }
     const auto [deskewed, keypoints] = kiss_.RegisterFrame(points, times);
     stats_.points_downsampled = keypoints.size();
     last_frame_.points.clear();
     for (const Eigen::Vector3d& p : deskewed) last_frame_.points.push_back(p.cast<float>());
-    last_pose_ = from_matrix(kiss_.pose().matrix());
+    // Deskewed frames are placed at the scan's end; our poses (and ground truth) are the frame
+    // start's, one frame-to-frame motion earlier.
+    const Sophus::SE3d frame_start = timed ? kiss_.pose() * kiss_.delta().inverse() : kiss_.pose();
+    last_pose_ = from_matrix(frame_start.matrix());
     stats_.total_ms = stats_.coarse_ms =
         std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     return last_pose_;
@@ -73,6 +71,7 @@ class KissOdometry final : public FrameOdometry {
   }
 
   kiss_icp::pipeline::KissICP kiss_;
+  bool config_deskew_;
   FrameStats stats_;
   PointCloud last_frame_;
   Pose last_pose_ = Pose::Identity();
