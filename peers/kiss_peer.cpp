@@ -33,7 +33,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-Pose to_pose(const Sophus::SE3d& T) { return from_matrix(T.matrix()); }
+Pose to_pose(const Sophus::SE3d& T) {
+  return from_matrix(T.matrix());
+}
 
 class KissOdometry final : public FrameOdometry {
  public:
