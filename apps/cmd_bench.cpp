@@ -17,7 +17,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--preset", o->presets,
                   "Simulator presets (default: the CTF-ICP paper's five data sets)");
   cmd->add_option("--sequence", o->sequences, "Sequence folders (with ground truth) to add");
-  cmd->add_option("--method", o->methods,
+  cmd->add_option("--method,--methods", o->methods,
                   "Methods (default: ctf-icp icp ndt gicp vgicp loam point-to-plane "
                   "point-to-line; any of " +
                       odometry_methods_with_peers() + ")");
