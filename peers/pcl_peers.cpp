@@ -92,39 +92,33 @@ class PclOdometry final : public FrameOdometry {
     const Eigen::Matrix4f initial = to_matrix(guess).cast<float>();
     Cloud aligned;
     Eigen::Matrix4f result = initial;
+    // What every PCL registration shares; the method-specific settings come first.
+    const auto run = [&](pcl::Registration<pcl::PointXYZ, pcl::PointXYZ>& registration) {
+      registration.setMaximumIterations(30);
+      registration.setInputSource(source);
+      registration.setInputTarget(previous_);
+      registration.align(aligned, initial);
+      converged_ = registration.hasConverged();
+      result = registration.getFinalTransformation();
+    };
     if (method_ == PclMethod::kIcp) {
       pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> icp;
       icp.setMaxCorrespondenceDistance(1.0);
-      icp.setMaximumIterations(30);
       icp.setTransformationEpsilon(1e-10);
-      icp.setInputSource(source);
-      icp.setInputTarget(previous_);
-      icp.align(aligned, initial);
-      converged_ = icp.hasConverged();
-      result = icp.getFinalTransformation();
+      run(icp);
       stats_.iterations = icp.nr_iterations_;
     } else if (method_ == PclMethod::kGicp) {
       pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
       gicp.setMaxCorrespondenceDistance(1.0);
-      gicp.setMaximumIterations(30);
       gicp.setCorrespondenceRandomness(20);
-      gicp.setInputSource(source);
-      gicp.setInputTarget(previous_);
-      gicp.align(aligned, initial);
-      converged_ = gicp.hasConverged();
-      result = gicp.getFinalTransformation();
+      run(gicp);
       stats_.iterations = gicp.nr_iterations_;
     } else {
       pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
       ndt.setResolution(static_cast<float>(config_.ndt_resolution));
       ndt.setStepSize(0.1);
       ndt.setTransformationEpsilon(0.001);
-      ndt.setMaximumIterations(30);
-      ndt.setInputSource(source);
-      ndt.setInputTarget(previous_);
-      ndt.align(aligned, initial);
-      converged_ = ndt.hasConverged();
-      result = ndt.getFinalTransformation();
+      run(ndt);
       stats_.iterations = ndt.getFinalNumIteration();
     }
     return from_matrix(result.cast<double>());

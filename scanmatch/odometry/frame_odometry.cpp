@@ -3,7 +3,6 @@
 #include <map>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
 namespace {
@@ -62,7 +61,7 @@ void check_odometry_method(const std::string& method) {
     if (method == known.name)
       throw Error("odometry method '" + method +
                   "' is a peer this build does not have: configure with " + known.option);
-  if (method != "ctf-icp" && !is_registration_method(method))
+  if (!is_odometry_method(method))
     throw Error("unknown odometry method '" + method +
                 "' (valid: " + odometry_methods_with_peers() + ")");
 }

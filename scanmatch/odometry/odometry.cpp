@@ -38,6 +38,10 @@ GaussianVoxelMapOptions ndt_options(const OdometryConfig& c) {
 
 }  // namespace
 
+bool is_odometry_method(const std::string& name) {
+  return name == "ctf-icp" || is_registration_method(name);
+}
+
 std::string odometry_method_list() {
   return "ctf-icp, " + registration_method_list();
 }
@@ -45,7 +49,7 @@ std::string odometry_method_list() {
 namespace {
 
 void check_config(const OdometryConfig& c) {
-  if (c.method != "ctf-icp" && !is_registration_method(c.method))
+  if (!is_odometry_method(c.method))
     throw Error("unknown odometry method '" + c.method + "' (valid: " + odometry_method_list() +
                 ")");
   const auto positive = [](double v, const char* name) {
@@ -74,7 +78,9 @@ void check_config(const OdometryConfig& c) {
 class FrameMotion {
  public:
   FrameMotion(const Pose& motion, double period, double max_time, double reference)
-      : xi_(se3_log(motion) / period) {
+      : xi_(se3_log(motion) / period),
+        angular_(xi_.head<3>().cast<float>()),
+        linear_(xi_.tail<3>().cast<float>()) {
     step_ = std::max(max_time, 1e-6) / (kBins - 1);
     for (int k = 0; k < kBins; ++k)
       bins_[k] = se3_exp(xi_ * (k * step_ - reference)).matrix().cast<float>();
@@ -84,14 +90,14 @@ class FrameMotion {
     // the clamp maps any negative time to the first bin either way.
     const int k = std::clamp(static_cast<int>(t / step_ + 0.5), 0, kBins - 1);
     const float ds = t - static_cast<float>(k * step_);
-    const Eigen::Vector3f w = xi_.head<3>().cast<float>(), v = xi_.tail<3>().cast<float>();
-    const Point q = p + ds * (w.cross(p) + v);
+    const Point q = p + ds * (angular_.cross(p) + linear_);
     return bins_[k].topLeftCorner<3, 3>() * q + bins_[k].topRightCorner<3, 1>();
   }
 
  private:
   static constexpr int kBins = 64;
-  Vector6d xi_;  ///< twist per second
+  Vector6d xi_;                       ///< twist per second
+  Eigen::Vector3f angular_, linear_;  ///< its halves in float, for the per-point step
   double step_;
   Eigen::Matrix4f bins_[kBins];
 };
@@ -294,11 +300,9 @@ Pose Odometry::register_frame(const PointCloud& frame, double timestamp) {
     stats_.map_ms = ms_since(map_start);
   }
   // A bridged frame keeps the last good velocity rather than one derived from the prior itself.
-  if (frames_ > 0)
-    record_motion(adaptive_, orthonormalized(pose_.inverse() * estimate), stats_.bridged, step,
-                  config_);
-  if (!stats_.bridged && config_.constant_velocity)
-    velocity_ = frames_ > 0 ? orthonormalized(pose_.inverse() * estimate) : Pose::Identity();
+  const Pose motion = frames_ > 0 ? orthonormalized(pose_.inverse() * estimate) : Pose::Identity();
+  if (frames_ > 0) record_motion(adaptive_, motion, stats_.bridged, step, config_);
+  if (!stats_.bridged && config_.constant_velocity) velocity_ = motion;
   pose_ = estimate;
   // The registration estimated the pose at mid-frame (the deskew reference, and the average of a
   // distorted frame's instants); the frame-start pose lies half the frame motion before it.

@@ -97,6 +97,8 @@ struct FrameStats {
 
 /// "ctf-icp, icp, ...": the odometry's methods (ctf-icp and every registration method).
 std::string odometry_method_list();
+/// ctf-icp or a registration method (optional peers: frame_odometry.hpp).
+bool is_odometry_method(const std::string& name);
 
 class Odometry {
  public:

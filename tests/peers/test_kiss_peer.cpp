@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include "peer_run.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/run.hpp"
 #include "scanmatch/sim/simulator.hpp"
@@ -16,13 +17,7 @@ using namespace scanmatch;
 TEST(KissPeer, TracksThirtyFramesOfAFastDrive) {
   // Measured on 30 frames of dynamic-outdoor-fast, one thread: 0.48 % of the path (200 frames:
   // 0.35 %, docs/benchmarks.md, Peers).
-  OdometryConfig config;
-  config.method = "kiss-icp";
-  const auto source = sim::open_sequence("sim:dynamic-outdoor-fast");
-  RunOptions options;
-  options.max_frames = 30;
-  options.quiet = true;
-  const RunSummary run = run_odometry(*source, config, options);
+  const RunSummary run = scanmatch::testing::run_peer("kiss-icp", "dynamic-outdoor-fast", 30);
   ASSERT_EQ(run.frames, 30u);
   ASSERT_TRUE(run.ate.has_value());
   EXPECT_LT(run.ate->rmse_percent_of_path, 1.0);

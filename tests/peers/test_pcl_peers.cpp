@@ -3,9 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "scanmatch/odometry/frame_odometry.hpp"
-#include "scanmatch/odometry/run.hpp"
-#include "scanmatch/sim/simulator.hpp"
+#include "peer_run.hpp"
 
 using namespace scanmatch;
 
@@ -14,13 +12,7 @@ TEST(PclPeers, NdtAndGicpTrackFortyFramesOfAFastDrive) {
   // Measured on 40 frames of dynamic-outdoor-fast: pcl-ndt 1.23 %, pcl-gicp 1.83 % (pcl-icp 8.7 %,
   // a point-to-point matcher on a non-repetitive pattern, is not held to a bound).
   for (const auto& [method, bound] : {std::pair{"pcl-ndt", 2.5}, std::pair{"pcl-gicp", 3.5}}) {
-    OdometryConfig config;
-    config.method = method;
-    const auto source = sim::open_sequence("sim:dynamic-outdoor-fast");
-    RunOptions options;
-    options.max_frames = 40;
-    options.quiet = true;
-    const RunSummary run = run_odometry(*source, config, options);
+    const RunSummary run = scanmatch::testing::run_peer(method, "dynamic-outdoor-fast", 40);
     ASSERT_EQ(run.frames, 40u);
     ASSERT_TRUE(run.ate.has_value());
     EXPECT_LT(run.ate->rmse_percent_of_path, bound) << method;
