@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
@@ -253,6 +254,36 @@ TEST(Odometry, BadFramesAreBridgedNeverFatal) {
   // After the gap the next good frame registers again.
   odometry.register_frame(s.frames[6], 0.6);
   EXPECT_FALSE(odometry.last_stats().bridged);
+}
+
+// This round's fields (coarse stage stop, keyframe prior): each bad value is named in the error.
+TEST(Odometry, NewConfigurationFieldsAreValidatedByName) {
+  const auto error_for = [](const auto& set) {
+    OdometryConfig c;
+    set(c);
+    try {
+      Odometry odometry(c);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_for([](OdometryConfig& c) { c.coarse_tolerance = 0.0; }).find("coarse_tolerance"),
+            std::string::npos);
+  EXPECT_NE(error_for([](OdometryConfig& c) {
+              c.coarse_tolerance = std::numeric_limits<double>::quiet_NaN();
+            }).find("coarse_tolerance"),
+            std::string::npos);
+  EXPECT_NE(error_for([](OdometryConfig& c) { c.max_step_ratio = 0.5; }).find("max_step_ratio"),
+            std::string::npos);
+  EXPECT_NE(
+      error_for([](OdometryConfig& c) { c.uncertain_ndt_scale = 0.5; }).find("uncertain_ndt_scale"),
+      std::string::npos);
+  EXPECT_NE(error_for([](OdometryConfig& c) {
+              c.prior_miss_distance = -1.0;
+            }).find("prior_miss_distance"),
+            std::string::npos);
+  EXPECT_EQ(error_for([](OdometryConfig&) {}), "");
 }
 
 TEST(Odometry, InvalidConfigurationsAreRejected) {
