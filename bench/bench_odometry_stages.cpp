@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "scanmatch/geometry/voxel_filter.hpp"
-#include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/ctf_icp_odometry.hpp"
 #include "scanmatch/registration/factors/ctf_fine.hpp"
 #include "scanmatch/registration/factors/ndt.hpp"
 #include "scanmatch/sim/simulator.hpp"
@@ -22,7 +22,7 @@ constexpr std::size_t kWholeFrames = 150;
 
 struct StageState {
   OdometryConfig config;
-  Odometry odometry{config};
+  CtfIcpOdometry odometry{config};
   PointCloud raw;                // frame 60 as the sensor gives it
   std::vector<PointCloud> next;  // frames 60 to 79
   std::vector<double> next_times;
@@ -55,7 +55,7 @@ const StageState& state() {
     st->down = voxel_downsample(st->raw, st->config.voxel_size);
     st->coarse = voxel_downsample(st->down, st->config.coarse_voxel_size);
     // The reference pose of frame 60: register it once (a copy of the odometry keeps the map).
-    Odometry copy = st->odometry;
+    CtfIcpOdometry copy = st->odometry;
     copy.register_frame(st->raw, sim.frame_time(60));
     st->estimate = copy.last_internal_pose();
     return st;
@@ -133,9 +133,8 @@ void BM_StageFineLinearizeHinted(benchmark::State& bench) {
 
 void coarse_linearize(benchmark::State& bench, bool hinted) {
   const StageState& s = state();
-  double d1, d2;
-  ndt_score_constants(s.config.ndt_resolution, s.config.registration.ndt_outlier_ratio, d1, d2);
-  NdtFactor factor{s.coarse, s.previous_ndt, s.config.ndt_neighbours, d1, d2};
+  NdtFactor factor = ndt_factor(s.coarse, s.previous_ndt, s.config.ndt_neighbours,
+                                s.config.registration.ndt_outlier_ratio);
   if (hinted) factor.hints.resize(s.coarse.size());
   const Pose increment = s.previous_pose.inverse() * s.estimate;
   linearize_all(factor, increment, SolverOptions{});
@@ -180,7 +179,7 @@ void BM_StageDownsample(benchmark::State& bench) {
 // Frames 60 to 209 in order, one per iteration, through a copy of the odometry made once.
 void BM_StageWholeFrame(benchmark::State& bench) {
   const StageState& s = state();
-  Odometry copy = s.odometry;
+  CtfIcpOdometry copy = s.odometry;
   std::size_t i = 0;
   for (auto _ : bench) {
     benchmark::DoNotOptimize(copy.register_frame(s.next[i], s.next_times[i]));

@@ -1,7 +1,8 @@
 // PCL's ICP, NDT and GICP as frame-to-frame odometry peers (`--method pcl-icp`, `pcl-ndt`,
 // `pcl-gicp`), built with -DSCANMATCH_WITH_PCL=ON. They see what our frame-to-frame baselines see:
-// the frame cropped to the configured ranges and voxel-downsampled to voxel_size, registered to
-// the previous frame from the constant-velocity guess, with the settings of the pair benchmark
+// the frame through our Preprocessor (range crop, voxel_size with the sparse-frame point floor, no
+// deskew), registered to the previous frame from the constant-velocity guess, with the settings of
+// the pair benchmark
 // (bench/pcl/bench_pcl.cpp). A registration that does not converge or leaves the prior by more
 // than max_jump / max_jump_angle is bridged by the prior, as ours are.
 
@@ -14,8 +15,8 @@
 #include <chrono>
 #include <memory>
 
-#include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
+#include "scanmatch/odometry/preprocessor.hpp"
 
 namespace scanmatch {
 namespace {
@@ -38,22 +39,21 @@ enum class PclMethod { kIcp, kNdt, kGicp };
 
 class PclOdometry final : public FrameOdometry {
  public:
-  PclOdometry(const OdometryConfig& config, PclMethod method) : config_(config), method_(method) {}
+  PclOdometry(const OdometryConfig& config, PclMethod method)
+      : config_(config), method_(method), preprocessor_(preprocess_options(config, false)) {}
 
   Pose register_frame(const PointCloud& frame, double) override {
     const auto start = Clock::now();
     stats_ = FrameStats{};
     stats_.points_in = frame.size();
-    PointCloud down = crop_range(frame, config_.min_range, config_.max_range);
-    if (config_.voxel_size > 0.0) down = voxel_downsample(down, config_.voxel_size);
+    PointCloud down = preprocessor_.process(frame);
     stats_.points_downsampled = down.size();
     stats_.preprocess_ms = ms_since(start);
 
     Pose motion = velocity_;
     const bool first = !previous_;
     Cloud::Ptr current = to_pcl(down);
-    constexpr std::size_t kMinimumPoints = 20;
-    if (!first && down.size() >= kMinimumPoints && previous_->size() >= kMinimumPoints) {
+    if (!first && down.size() >= kMinimumFramePoints && previous_->size() >= kMinimumFramePoints) {
       const auto coarse_start = Clock::now();
       const Pose estimate = align(current, velocity_);
       stats_.coarse_ms = ms_since(coarse_start);
@@ -71,7 +71,7 @@ class PclOdometry final : public FrameOdometry {
       pose_ = orthonormalized(pose_ * motion);
       if (!stats_.bridged && config_.constant_velocity) velocity_ = motion;
     }
-    if (down.size() >= kMinimumPoints || !previous_) {
+    if (down.size() >= kMinimumFramePoints || !previous_) {
       previous_ = current;
       previous_frame_ = std::move(down);
       previous_pose_ = pose_;
@@ -126,6 +126,7 @@ class PclOdometry final : public FrameOdometry {
 
   OdometryConfig config_;
   PclMethod method_;
+  Preprocessor preprocessor_;  ///< ours: the peers see the frames our pipelines see
   FrameStats stats_;
   Cloud::Ptr previous_;
   PointCloud previous_frame_;

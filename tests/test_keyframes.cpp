@@ -1,7 +1,7 @@
 // Sparse keyframes: the simulator's keyframe output (exact ground truth of the kept frames) and
 // CTF-ICP with default options on keyframe sequences (a spinning 64-ring sensor every 5th frame,
 // Livox Avia keyframes 0.75 m and 0.5-1 m apart with 4000 points and no point time), against the
-// adaptive rules of scanmatch/odometry/adaptive.hpp.
+// adaptive rules of scanmatch/odometry/motion_model.hpp and preprocessor.hpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,8 +12,9 @@
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/cloud_io.hpp"
-#include "scanmatch/odometry/adaptive.hpp"
+#include "scanmatch/odometry/motion_model.hpp"
 #include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/preprocessor.hpp"
 #include "scanmatch/sim/keyframes.hpp"
 #include "test_helpers.hpp"
 
@@ -188,39 +189,58 @@ TEST(Keyframes, AviaKeyframesWithoutPointTimeAreTracked) {
   EXPECT_GT(track(k, without_adaptive_rules()).rmse_percent_of_path, 2.0);
 }
 
+// A motion model that has measured `velocity` over 0.1 s steps (frames 0 to 4 at 0.1 s).
+MotionModel measured(const OdometryConfig& c, const Pose& velocity) {
+  MotionModel model(c);
+  for (std::size_t frame = 0; frame < 5; ++frame) {
+    model.predict(0.1 * static_cast<double>(frame), frame);
+    if (frame > 0) model.record(velocity, false);
+  }
+  return model;
+}
+
 TEST(AdaptiveRules, ThePriorScalesWithTheTimeStepAndIsUncertainWhenTheStepIsUnknown) {
   OdometryConfig c;
-  AdaptiveState state;
-  state.velocity_period = 0.1;
   const Pose velocity = from_xyz_rpy(0.5, 0.1, 0.0, 0.0, 0.0, 0.05);
+  const auto prior_after = [&](double step) {
+    MotionModel model = measured(c, velocity);
+    return model.predict(0.4 + step, 5);
+  };
   // Regular steps (jitter included): the last motion itself, certain.
-  MotionPrior p = predict_motion(state, velocity, 0.1 + 1e-4, 5, c);
+  MotionPrior p = prior_after(0.1 + 1e-4);
   EXPECT_FALSE(p.uncertain);
   EXPECT_TRUE(p.motion.isApprox(velocity, 0.0));
   // Twice the step: the same motion twice (constant twist).
-  p = predict_motion(state, velocity, 0.2, 5, c);
+  p = prior_after(0.2);
   EXPECT_FALSE(p.uncertain);
   const Pose twice = velocity * velocity;
   EXPECT_NEAR((p.motion.translation() - twice.translation()).norm(), 0.0, 1e-9);
   EXPECT_NEAR(rotation_angle(p.motion), 0.1, 1e-9);
   // A gap of 10 steps: scaled by max_step_ratio at most, and uncertain.
-  p = predict_motion(state, velocity, 1.0, 5, c);
+  p = prior_after(1.0);
   EXPECT_TRUE(p.uncertain);
   EXPECT_NEAR(rotation_angle(p.motion), 0.05 * c.max_step_ratio, 1e-9);
   // No increasing stamps; the first registered frame; after a bridged frame: uncertain.
-  EXPECT_TRUE(predict_motion(state, velocity, 0.0, 5, c).uncertain);
-  EXPECT_TRUE(predict_motion(state, velocity, 0.1, 1, c).uncertain);
-  AdaptiveState bridged = state;
-  record_motion(bridged, velocity, true, 0.1, c);
-  EXPECT_TRUE(predict_motion(bridged, velocity, 0.1, 5, c).uncertain);
-  EXPECT_DOUBLE_EQ(jump_gate_scale(AdaptiveState{}, c), 1.0);
+  EXPECT_TRUE(prior_after(0.0).uncertain);
+  EXPECT_TRUE(MotionModel(c).predict(0.1, 1).uncertain);
+  MotionModel bridged = measured(c, velocity);
+  bridged.predict(0.5, 5);
+  bridged.record(velocity, true);
+  EXPECT_TRUE(bridged.predict(0.6, 6).uncertain);
+  // The gate: max_jump around the prediction, widened under an uncertain prior.
+  MotionModel regular = measured(c, velocity);
+  regular.predict(0.5, 5);
+  const Pose beyond = from_xyz_rpy(1.5 * c.max_jump, 0.0, 0.0, 0.0, 0.0, 0.0);
+  EXPECT_TRUE(regular.within_gate(Pose::Identity(), Pose::Identity()));
+  EXPECT_FALSE(regular.within_gate(Pose::Identity(), beyond));
   // An estimate far from its prior (irregular steps without stamps) makes the next one uncertain.
-  AdaptiveState missed = state;
-  missed.prior = predict_motion(state, velocity, 0.1, 5, c);
-  record_motion(missed, from_xyz_rpy(1.0, 0.1, 0.0, 0.0, 0.0, 0.05), false, 0.1, c);
-  missed.prior = predict_motion(missed, velocity, 0.1, 5, c);
-  EXPECT_TRUE(missed.prior.uncertain);
-  EXPECT_DOUBLE_EQ(jump_gate_scale(missed, c), c.uncertain_jump_scale);
+  MotionModel missed = measured(c, velocity);
+  missed.predict(0.5, 5);
+  missed.record(from_xyz_rpy(1.0, 0.1, 0.0, 0.0, 0.0, 0.05), false);
+  EXPECT_TRUE(missed.predict(0.6, 6).uncertain);
+  EXPECT_TRUE(missed.within_gate(Pose::Identity(), beyond));
+  EXPECT_FALSE(missed.within_gate(
+      Pose::Identity(), from_xyz_rpy(1.01 * c.uncertain_jump_scale * c.max_jump, 0, 0, 0, 0, 0)));
 }
 
 TEST(AdaptiveRules, ASparseFrameKeepsMorePointsADenseOneIsUnchanged) {
@@ -230,7 +250,8 @@ TEST(AdaptiveRules, ASparseFrameKeepsMorePointsADenseOneIsUnchanged) {
   for (int i = 0; i < 1500; ++i)
     sparse.points.emplace_back(5.0f, -1.5f + 3.0f * float(i % 39) / 39.0f,
                                -1.5f + 3.0f * float(i / 39) / 39.0f);
-  const PointCloud more = adaptive_downsample(sparse, sparse.size(), c);
+  const PreprocessOptions o = preprocess_options(c, false);
+  const PointCloud more = adaptive_downsample(sparse, sparse.size(), o);
   EXPECT_GT(more.size(), 4 * voxel_downsample(sparse, c.voxel_size).size());
   EXPECT_LE(more.size(), sparse.size());
   // A frame delivered dense (10x the floor) that sees only a near wall keeps the plain filter.
@@ -238,12 +259,12 @@ TEST(AdaptiveRules, ASparseFrameKeepsMorePointsADenseOneIsUnchanged) {
   for (int i = 0; i < 10000; ++i)
     wall.points.emplace_back(1.0f, -1.0f + 2.0f * float(i % 100) / 100.0f,
                              -1.0f + 2.0f * float(i / 100) / 100.0f);
-  EXPECT_EQ(adaptive_downsample(wall, wall.size(), c).points,
+  EXPECT_EQ(adaptive_downsample(wall, wall.size(), o).points,
             voxel_downsample(wall, c.voxel_size).points);
   // 40 x 40 m of ground every 0.1 m: 25600 voxels, more than enough.
   for (int i = 0; i < 400; ++i)
     for (int j = 0; j < 400; ++j)
       dense.points.emplace_back(-20.0f + 0.1f * i, -20.0f + 0.1f * j, -1.0f);
-  EXPECT_EQ(adaptive_downsample(dense, dense.size(), c).points,
+  EXPECT_EQ(adaptive_downsample(dense, dense.size(), o).points,
             voxel_downsample(dense, c.voxel_size).points);
 }

@@ -11,6 +11,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
+#include "scanmatch/odometry/ctf_icp_odometry.hpp"
 #include "scanmatch/odometry/odometry.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
@@ -145,7 +146,7 @@ TEST(Odometry, MapMemoryStaysFlatWithASmallRadius) {
   const Sequence& s = simulated("dynamic-outdoor-fast", 300);
   OdometryConfig c = with_method("ctf-icp");
   c.map_radius = 15.0;
-  Odometry odometry(c);
+  CtfIcpOdometry odometry(c);
   const std::size_t frames = sanitized() ? 60 : 300;
   std::size_t first_half = 0, second_half = 0;
   for (std::size_t i = 0; i < frames; ++i) {
@@ -154,7 +155,8 @@ TEST(Odometry, MapMemoryStaysFlatWithASmallRadius) {
         std::max(i < frames / 2 ? first_half : second_half, odometry.map().size());
     if (i + 1 == frames) {
       // Every voxel lies within the radius (plus the pruning interval) of the sensor.
-      const Eigen::Vector3d sensor = (odometry.world_from_map().inverse() * pose).translation();
+      const Eigen::Vector3d sensor =
+          (odometry.world_from_internal().inverse() * pose).translation();
       for (const GaussianVoxel& v : odometry.map().voxels())
         if (v.count > 0) {
           EXPECT_LT((v.mean - sensor).norm(), 1.1 * c.map_radius + 1.0);

@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "scanmatch/eval/metrics.hpp"
-#include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/ctf_icp_odometry.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 int main(int argc, char** argv) {
@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
         scanmatch::sim::open_sequence(argc > 1 ? argv[1] : "sim:dynamic-outdoor-fast", sim);
 
     scanmatch::OdometryConfig config;  // ctf-icp with the documented defaults
-    scanmatch::Odometry odometry(config);
+    scanmatch::CtfIcpOdometry odometry(config);
     std::vector<scanmatch::Pose> poses;
     scanmatch::Frame frame;
     while (poses.size() < 50 && source->next(frame)) {

@@ -7,14 +7,16 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <thread>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/report.hpp"
 #include "scanmatch/eval/svg_plot.hpp"
-#include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
+#include "scanmatch/odometry/preprocessor.hpp"
+#include "scanmatch/registration/methods.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch {
@@ -159,6 +161,14 @@ std::string cached_dataset(const std::string& preset, const std::string& data, s
 double accuracy_score(const std::string& data_folder, const std::vector<Pose>& poses) {
   if (poses.size() < 2) return 0.0;
   auto source = open_sequence_folder(data_folder);
+  // The score's own frames, the same whatever the method's preprocessing: 0.25 m voxels, no crop.
+  PreprocessOptions options;
+  options.min_range = 0.0;
+  options.max_range = std::numeric_limits<double>::infinity();
+  options.voxel_size = 0.25;
+  options.min_downsampled_points = 0;
+  options.keep_attributes = false;
+  const Preprocessor scoring(options);
   const std::size_t step = std::max<std::size_t>(1, poses.size() / 30);
   double sum = 0.0;
   std::size_t pairs = 0;
@@ -167,7 +177,7 @@ double accuracy_score(const std::string& data_folder, const std::vector<Pose>& p
   for (std::size_t i = 0; i < poses.size() && source->next(frame); ++i) {
     const bool wanted = i % step == 0 || (i + 1 < poses.size() && (i + 1) % step == 0);
     if (!wanted) continue;
-    PointCloud down = voxel_downsample(frame.cloud, 0.25);
+    PointCloud down = scoring.process(frame.cloud);
     if (i % step == 0 && i > 0 && !previous.empty()) {
       sum += fitness_score(down, previous, poses[i - 1].inverse() * poses[i], 1.0);
       ++pairs;

@@ -3,6 +3,8 @@
 #include <map>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/odometry_pipeline.hpp"
 
 namespace scanmatch {
 namespace {
@@ -31,22 +33,6 @@ constexpr KnownPeer kKnownPeers[] = {
     {"kiss-icp", "-DSCANMATCH_WITH_KISS=ON (KISS-ICP installed; docs/benchmarks.md, Peers)"},
 };
 
-class OursOdometry final : public FrameOdometry {
- public:
-  explicit OursOdometry(const OdometryConfig& config) : odometry_(config) {}
-  Pose register_frame(const PointCloud& frame, double timestamp) override {
-    return odometry_.register_frame(frame, timestamp);
-  }
-  const FrameStats& last_stats() const override { return odometry_.last_stats(); }
-  const PointCloud* last_map_frame(Pose& world_from_frame) const override {
-    world_from_frame = odometry_.world_from_map() * odometry_.last_internal_pose();
-    return &odometry_.last_frame();
-  }
-
- private:
-  Odometry odometry_;
-};
-
 }  // namespace
 
 bool register_odometry_peer(const std::string& name, const std::string& description,
@@ -70,7 +56,7 @@ std::unique_ptr<FrameOdometry> make_frame_odometry(const OdometryConfig& config)
   check_odometry_method(config.method);
   if (const auto it = peers().find(config.method); it != peers().end())
     return it->second.factory(config);
-  return std::make_unique<OursOdometry>(config);
+  return make_odometry_pipeline(config);
 }
 
 std::vector<std::string> odometry_peers() {

@@ -1,10 +1,11 @@
 #pragma once
-// One interface for every odometry the runner and the benchmark drive: ours (Odometry: ctf-icp
-// and every registration method frame-to-frame) and the optional peers built beside it (PCL's
-// ICP, NDT and GICP, KISS-ICP; peers/ at the repository root, CMake options SCANMATCH_WITH_PCL
-// and SCANMATCH_WITH_KISS). A peer registers itself by name at start-up; the core library never
-// depends on one.
+// One interface for every odometry the runner and the benchmark drive: ours (CtfIcpOdometry,
+// FrameToFrameOdometry for every registration method; odometry.hpp) and the optional peers built
+// beside it (PCL's ICP, NDT and GICP, KISS-ICP; peers/ at the repository root, CMake options
+// SCANMATCH_WITH_PCL and SCANMATCH_WITH_KISS). A peer registers itself by name at start-up; the
+// core library never depends on one.
 
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <string>
@@ -12,9 +13,14 @@
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/core/se3.hpp"
-#include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/frame_stats.hpp"
+#include "scanmatch/odometry/odometry_config.hpp"
 
 namespace scanmatch {
+
+/// Fewer points than this (in a frame, or paired by a stage) make a registration unusable: the
+/// frame is bridged by the motion prior.
+constexpr std::size_t kMinimumFramePoints = 20;
 
 class FrameOdometry {
  public:
@@ -38,8 +44,8 @@ using PeerFactory = std::function<std::unique_ptr<FrameOdometry>(const OdometryC
 bool register_odometry_peer(const std::string& name, const std::string& description,
                             PeerFactory factory);
 
-/// The odometry for config.method: a registered peer, or Odometry. Throws Error for an unknown
-/// method, naming the CMake option that builds a known peer this build lacks.
+/// The odometry for config.method: a registered peer, or ours (make_odometry_pipeline). Throws
+/// Error for an unknown method, naming the CMake option that builds a known peer this build lacks.
 std::unique_ptr<FrameOdometry> make_frame_odometry(const OdometryConfig& config);
 
 /// Throws what make_frame_odometry would for an unusable method, without building anything.

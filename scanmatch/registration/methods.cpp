@@ -104,9 +104,7 @@ RegistrationResult vgicp(const PointCloud& s, const PointCloud& t, const Options
 
 RegistrationResult ndt(const PointCloud& s, const PointCloud& t, const Options& o, const Pose& T) {
   const GaussianVoxelMap map = target_map(t, o);
-  double d1, d2;
-  ndt_score_constants(o.voxel_resolution, o.ndt_outlier_ratio, d1, d2);
-  return optimize(NdtFactor{s, map, voxel_neighbours(o, 7), d1, d2}, T, o.solver);
+  return optimize(ndt_factor(s, map, voxel_neighbours(o, 7), o.ndt_outlier_ratio), T, o.solver);
 }
 
 RegistrationResult ctf_fine(const PointCloud& s, const PointCloud& t, const Options& o,

@@ -77,4 +77,13 @@ struct NdtFactor {
   }
 };
 
+/// NDT of `source` against `grid` (the target's Gaussians), with the score constants of the
+/// grid's voxel size and `outlier_ratio`.
+inline NdtFactor ndt_factor(const PointCloud& source, const GaussianVoxelMap& grid, int neighbours,
+                            double outlier_ratio) {
+  double d1 = 0.0, d2 = 0.0;
+  ndt_score_constants(grid.options().voxel_size, outlier_ratio, d1, d2);
+  return NdtFactor{source, grid, neighbours, d1, d2};
+}
+
 }  // namespace scanmatch

@@ -1,0 +1,50 @@
+#pragma once
+// The coarse stage of CTF-ICP: NDT frame-to-frame. The frame, further downsampled to
+// coarse_voxel_size, is registered against the previous frame's NDT grid (ndt_resolution,
+// Magnusson's score) from the motion prior. Its job is only to bring the fine stage into its basin.
+//
+// Under an uncertain prior (motion_model.hpp) it also tries other starts: the identity, half and
+// twice the prior, each first on a grid uncertain_ndt_scale times wider, then on the normal grid;
+// the start whose result scores best on the normal grid (by a margin) wins.
+
+#include <cstddef>
+
+#include "scanmatch/core/point_cloud.hpp"
+#include "scanmatch/geometry/gaussian_voxel_map.hpp"
+#include "scanmatch/odometry/motion_model.hpp"
+#include "scanmatch/odometry/odometry_config.hpp"
+#include "scanmatch/registration/solver.hpp"
+
+namespace scanmatch {
+
+struct CoarseResult {
+  Pose motion = Pose::Identity();  ///< from the reference frame (the prior when not registered)
+  bool registered = false;         ///< enough points found a voxel; false: motion is the prior
+  int iterations = 0;              ///< every start's iterations
+  double condition_number = 0.0;   ///< of the plain start's information matrix
+};
+
+class CoarseNdt {
+ public:
+  explicit CoarseNdt(const OdometryConfig& config);
+  /// The frame's motion from the reference frame. `frame` is the preprocessed frame (the stage
+  /// downsamples it further). Without a reference, the prior's motion.
+  CoarseResult align(const PointCloud& frame, const MotionPrior& prior) const;
+  /// Makes `frame` (preprocessed, in its sensor frame) the next frame's reference. A bridged
+  /// frame without points keeps the last reference cloud (the grid is always the new frame's).
+  void set_reference(PointCloud frame, bool bridged);
+  /// The reference frame's points (the last frame registered).
+  const PointCloud& reference() const { return reference_; }
+
+ private:
+  /// The best motion among `plain` and the other starts (adds their iterations).
+  Pose best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
+                  int& iterations) const;
+
+  OdometryConfig config_;
+  SolverOptions solver_;
+  GaussianVoxelMap grid_;  ///< the reference frame's NDT grid, in its sensor frame
+  PointCloud reference_;
+};
+
+}  // namespace scanmatch

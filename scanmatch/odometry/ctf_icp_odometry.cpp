@@ -1,0 +1,47 @@
+#include "scanmatch/odometry/ctf_icp_odometry.hpp"
+
+#include "scanmatch/core/stopwatch.hpp"
+
+namespace scanmatch {
+
+CtfIcpOdometry::CtfIcpOdometry(const OdometryConfig& config)
+    : OdometryPipeline(config, /*keep_attributes=*/false),
+      coarse_(config),
+      fine_(config),
+      map_(config),
+      fine_stage_(config.fine_stage) {}
+
+Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
+                              const Pose& predicted, FrameStats& stats) {
+  if (frame.size() < kMinimumFramePoints) {
+    stats.bridged = true;
+    return predicted;
+  }
+  const Stopwatch coarse_time;
+  const CoarseResult coarse = coarse_.align(frame, prior);
+  Pose estimate = last_internal_pose() * coarse.motion;
+  stats.iterations = coarse.iterations;
+  stats.condition_number = coarse.condition_number;
+  stats.coarse_ms = coarse_time.ms();
+
+  if (fine_stage_ && map_.map().size() > 0) {
+    const Stopwatch fine_time;
+    const FineResult fine = fine_.refine(frame, map_.map(), estimate);
+    estimate = fine.pose;
+    stats.degenerate_directions = fine.degenerate_directions;
+    stats.iterations += fine.iterations;
+    stats.condition_number = fine.condition_number;
+    stats.fine_ms = fine_time.ms();
+  }
+  return estimate;
+}
+
+void CtfIcpOdometry::update_reference(PointCloud frame, const Pose& pose, bool bridged,
+                                      FrameStats& stats) {
+  const Stopwatch map_time;
+  map_.add(frame, pose, frames() == 0);
+  coarse_.set_reference(std::move(frame), bridged);
+  stats.map_ms = map_time.ms();
+}
+
+}  // namespace scanmatch

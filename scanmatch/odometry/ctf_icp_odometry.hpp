@@ -1,0 +1,38 @@
+#pragma once
+// CTF-ICP (docs/methods.md section 1), one stage per file:
+//   preprocessor.hpp  range crop, deskew, adaptive voxel filter (the shared frame loop runs it)
+//   motion_model.hpp  the prior, its uncertainty and the gate (the shared frame loop)
+//   coarse_ndt.hpp    NDT frame-to-frame from the prior, other starts under an uncertain prior
+//   fine_stage.hpp    frame-to-map on the planar Gaussians, degeneracy guard
+//   map_update.hpp    the global Gaussian map around the sensor
+// This file only chains them.
+
+#include "scanmatch/odometry/coarse_ndt.hpp"
+#include "scanmatch/odometry/fine_stage.hpp"
+#include "scanmatch/odometry/map_update.hpp"
+#include "scanmatch/odometry/odometry_pipeline.hpp"
+
+namespace scanmatch {
+
+class CtfIcpOdometry final : public OdometryPipeline {
+ public:
+  /// Throws Error for invalid parameters.
+  explicit CtfIcpOdometry(const OdometryConfig& config);
+  const PointCloud& last_frame() const override { return coarse_.reference(); }
+  /// The global Gaussian map, in the internal world frame (world_from_internal() * x gives the
+  /// world frame of the returned poses).
+  const GaussianVoxelMap& map() const { return map_.map(); }
+
+ private:
+  Pose estimate(const PointCloud& frame, const MotionPrior& prior, const Pose& predicted,
+                FrameStats& stats) override;
+  void update_reference(PointCloud frame, const Pose& pose, bool bridged,
+                        FrameStats& stats) override;
+
+  CoarseNdt coarse_;
+  FineStage fine_;
+  MapUpdate map_;
+  bool fine_stage_;
+};
+
+}  // namespace scanmatch

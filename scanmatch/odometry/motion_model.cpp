@@ -1,0 +1,69 @@
+#include "scanmatch/odometry/motion_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace scanmatch {
+namespace {
+
+/// Time-step ratios this close to 1 count as regular: timestamp jitter is not motion.
+constexpr double kRegularStep = 0.05;
+
+Pose scaled(const Pose& motion, double factor) {
+  return se3_exp(factor * se3_log(motion));
+}
+
+}  // namespace
+
+MotionModel::MotionModel(const OdometryConfig& config) : config_(config) {}
+
+const MotionPrior& MotionModel::predict(double timestamp, std::size_t frames) {
+  step_ = frames > 0 ? timestamp - last_timestamp_ : 0.0;
+  if (frames > 0 && timestamp > last_timestamp_) frame_period_ = timestamp - last_timestamp_;
+  last_timestamp_ = timestamp;
+
+  prior_ = MotionPrior{};
+  prior_.motion = velocity_;
+  if (!config_.constant_velocity) return prior_;  // the previous pose is the guess
+  // Frame 1 has no motion yet (the identity), and a bridged frame's motion was not measured.
+  prior_.uncertain = frames == 1 || previous_bridged_ || previous_missed_;
+  if (!config_.time_scaled_prior || frames < 2) return prior_;
+  if (!(step_ > 0.0) || !(velocity_period_ > 0.0)) {
+    prior_.uncertain = true;  // no usable stamps: the step is unknown
+    return prior_;
+  }
+  const double ratio = step_ / velocity_period_;
+  if (std::abs(ratio - 1.0) <= kRegularStep) return prior_;
+  if (ratio > config_.max_step_ratio || ratio < 1.0 / config_.max_step_ratio) {
+    // A gap (dropped frames) or a burst: scale within bounds, but trust it less.
+    prior_.uncertain = true;
+    prior_.scale = std::clamp(ratio, 1.0 / config_.max_step_ratio, config_.max_step_ratio);
+  } else {
+    prior_.scale = ratio;
+  }
+  prior_.motion = scaled(velocity_, prior_.scale);
+  return prior_;
+}
+
+bool MotionModel::within_gate(const Pose& predicted, const Pose& estimate) const {
+  const double widen = prior_.uncertain ? config_.uncertain_jump_scale : 1.0;
+  const Pose jump = predicted.inverse() * estimate;
+  return to_matrix(estimate).allFinite() && jump.translation().norm() <= widen * config_.max_jump &&
+         rotation_angle(jump) <= widen * config_.max_jump_angle;
+}
+
+bool MotionModel::moving(const Pose& motion, double factor) const {
+  return motion.translation().norm() >= factor * config_.deskew_min_translation ||
+         rotation_angle(motion) >= factor * config_.deskew_min_rotation;
+}
+
+void MotionModel::record(const Pose& motion, bool bridged) {
+  const Pose miss = prior_.motion.inverse() * motion;
+  previous_missed_ = !bridged && (miss.translation().norm() > config_.prior_miss_distance ||
+                                  rotation_angle(miss) > config_.prior_miss_angle);
+  previous_bridged_ = bridged;
+  if (!bridged) velocity_period_ = step_ > 0.0 ? step_ : velocity_period_;
+  if (!bridged && config_.constant_velocity) velocity_ = motion;
+}
+
+}  // namespace scanmatch

@@ -1,0 +1,61 @@
+#pragma once
+// The motion model of the odometry: the prior of each frame's motion, how far it can be trusted,
+// the gate a registration result must pass, and the record of past motion it learns from.
+//
+// - Constant velocity, time-scaled: the prior is the last measured motion, scaled by the ratio of
+//   the frame time steps (keyframe folders have irregular steps).
+// - The prior is *uncertain* for the first registered frame, when the time stamps do not increase
+//   or their ratio is outside [1/max_step_ratio, max_step_ratio], after a bridged frame, and after
+//   a frame whose estimate missed its prior by more than prior_miss_distance / prior_miss_angle.
+//   An uncertain prior makes the coarse stage try other starts and widens the gate by
+//   uncertain_jump_scale.
+// - A bridged frame (no usable registration) keeps the last measured velocity: its own motion is
+//   the prior itself, not a measurement.
+//
+// With regular time steps and an accurate prior, the prior is the last motion, unscaled.
+
+#include <cstddef>
+
+#include "scanmatch/core/se3.hpp"
+#include "scanmatch/odometry/odometry_config.hpp"
+
+namespace scanmatch {
+
+/// The prediction of one frame's motion from the last one.
+struct MotionPrior {
+  Pose motion = Pose::Identity();  ///< predicted motion from the last frame's pose
+  double scale = 1.0;              ///< time-step ratio applied to the last motion
+  bool uncertain = false;          ///< the coarse stage tries other starts; the gate widens
+};
+
+class MotionModel {
+ public:
+  explicit MotionModel(const OdometryConfig& config);
+
+  /// Starts the next frame, taken at `timestamp` s, after `frames` registered ones: its prior.
+  const MotionPrior& predict(double timestamp, std::size_t frames);
+  /// The prior of the frame being registered.
+  const MotionPrior& prior() const { return prior_; }
+  /// The last measured motion between two frames (identity before the second frame).
+  const Pose& velocity() const { return velocity_; }
+  /// The last positive time step between frames, s (0.1 until one is known).
+  double frame_period() const { return frame_period_; }
+  /// True when `estimate` lies within the gate around `predicted` (widened under an uncertain
+  /// prior) and is finite.
+  bool within_gate(const Pose& predicted, const Pose& estimate) const;
+  /// Motion above `factor` times the deskew dead band (smaller motion is estimation noise).
+  bool moving(const Pose& motion, double factor = 1.0) const;
+  /// Records the frame's outcome: `motion` from the last pose, and whether it was bridged.
+  void record(const Pose& motion, bool bridged);
+
+ private:
+  OdometryConfig config_;
+  MotionPrior prior_;
+  Pose velocity_ = Pose::Identity();
+  double last_timestamp_ = 0.0, step_ = 0.0, frame_period_ = 0.1;
+  double velocity_period_ = 0.0;  ///< s spanned by velocity_ (0: unknown)
+  bool previous_bridged_ = false;
+  bool previous_missed_ = false;  ///< the last estimate was far from its prior
+};
+
+}  // namespace scanmatch

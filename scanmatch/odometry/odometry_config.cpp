@@ -1,0 +1,42 @@
+#include "scanmatch/odometry/odometry_config.hpp"
+
+#include <cmath>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/registration/methods.hpp"
+
+namespace scanmatch {
+
+bool is_odometry_method(const std::string& name) {
+  return name == "ctf-icp" || is_registration_method(name);
+}
+
+std::string odometry_method_list() {
+  return "ctf-icp, " + registration_method_list();
+}
+
+void check_odometry_config(const OdometryConfig& c) {
+  if (!is_odometry_method(c.method))
+    throw Error("unknown odometry method '" + c.method + "' (valid: " + odometry_method_list() +
+                ")");
+  const auto positive = [](double v, const char* name) {
+    if (!(v > 0.0) || !std::isfinite(v))
+      throw Error(std::string("odometry: ") + name + " must be positive");
+  };
+  positive(c.ndt_resolution, "ndt_resolution");
+  positive(c.map_voxel_size, "map_voxel_size");
+  positive(c.map_radius, "map_radius");
+  positive(c.max_range, "max_range");
+  positive(c.coarse_tolerance, "coarse_tolerance");
+  if (c.voxel_size < 0.0 || c.coarse_voxel_size < 0.0 || c.min_range < 0.0)
+    throw Error("odometry: voxel sizes and min_range must not be negative");
+  if (c.merge_threshold == 0) throw Error("odometry: merge_threshold must be at least 1");
+  if (c.threads < 1) throw Error("odometry: threads must be at least 1");
+  if (!(c.max_step_ratio >= 1.0)) throw Error("odometry: max_step_ratio must be at least 1");
+  if (!(c.uncertain_ndt_scale >= 1.0) || !(c.uncertain_jump_scale >= 1.0))
+    throw Error("odometry: uncertain_ndt_scale and uncertain_jump_scale must be at least 1");
+  positive(c.prior_miss_distance, "prior_miss_distance");
+  positive(c.prior_miss_angle, "prior_miss_angle");
+}
+
+}  // namespace scanmatch

@@ -1,0 +1,83 @@
+#pragma once
+// The configuration of the 3D odometry (every pipeline and stage reads its part of it). Each field
+// is described once, with its JSON key and flag, in config_fields.hpp.
+
+#include <cstdint>
+#include <string>
+
+#include "scanmatch/registration/options.hpp"
+
+namespace scanmatch {
+
+struct OdometryConfig {
+  std::string method = "ctf-icp";  ///< ctf-icp or any registration method (frame-to-frame)
+  double voxel_size = 0.25;        ///< m, downsampling of every frame (0: none)
+  double min_range = 0.3;          ///< m: nearer points (the robot itself) are dropped
+  double max_range = 100.0;        ///< m: farther points are dropped
+  // Coarse stage (ctf-icp): NDT against the previous frame.
+  double ndt_resolution = 1.0;     ///< m, the NDT grid of the previous frame
+  int ndt_neighbours = 1;          ///< voxels per point: 1, 7 or 27
+  double coarse_voxel_size = 0.7;  ///< m, further downsampling of the NDT source (0: none)
+  int coarse_max_iterations = 30;
+  double coarse_tolerance = 1e-4;  ///< m and rad: the coarse stage stops below this update
+  // Fine stage (ctf-icp): frame-to-map.
+  double map_voxel_size = 0.5;        ///< m, the global Gaussian map
+  std::uint32_t merge_threshold = 5;  ///< points pending before a map voxel is merged
+  double map_radius = 50.0;  ///< m: map voxels farther from the sensor are dropped (checked
+                             ///< whenever the sensor has moved a tenth of it)
+  /// Points a map voxel needs before the fine stage uses it.
+  std::uint32_t map_voxel_min_points = 5;
+  /// Points after which a map voxel is frozen (GaussianVoxelMapOptions::max_points; 0: never).
+  std::uint32_t map_voxel_max_points = 0;
+  int fine_max_iterations = 10;
+  double fine_tolerance = 1e-4;  ///< m and rad: the fine stage stops below this update
+  /// Map voxels flatter than this (smallest / middle eigenvalue) are used; 1: all (the paper).
+  double fine_max_flatness = 1.0;
+  /// m: plane distance where the fine stage's Cauchy kernel starts to down-weight (0: no kernel)
+  double fine_kernel_distance = 0.1;
+  /// Degeneracy guard of the fine stage (SolverOptions::degeneracy_ratio; 0: off).
+  double degeneracy_ratio = 0.02;
+  // Ablations of the paper's Table 5.
+  bool fine_stage = true;  ///< false: coarse NDT only
+  /// false: no global map; the fine stage registers against a map of the previous frame only.
+  bool map_update = true;
+  /// Constant-velocity motion prior; false: the previous pose is the initial guess.
+  bool constant_velocity = true;
+  /// Move each point to the frame's middle with the constant-velocity motion (needs point times);
+  /// the reported poses are still frame-start poses.
+  bool deskew = true;
+  /// Frames whose motion prior is below both thresholds are not deskewed: their distortion is
+  /// below the sensor noise, and deskewing by a velocity that is itself estimation noise feeds that
+  /// noise back into the next pose (a still sensor then drifts).
+  double deskew_min_translation = 0.01;  ///< m per frame
+  double deskew_min_rotation = 0.002;    ///< rad per frame
+  double max_jump = 1.0;        ///< m: a result farther than this from the prior is rejected
+  double max_jump_angle = 1.0;  ///< rad: likewise for rotation (hand-held motion turns fast)
+  // Sparse and irregular frames (motion_model.hpp, preprocessor.hpp; docs/odometry.md "Sparse
+  // keyframes").
+  /// Scale the constant-velocity prior by the ratio of the frame time steps.
+  bool time_scaled_prior = true;
+  double max_step_ratio = 4.0;  ///< time-step ratios beyond this (or its inverse) are uncertain
+  /// A frame whose estimate lies farther than this from its prior makes the next prior uncertain.
+  double prior_miss_distance = 0.2;  ///< m
+  double prior_miss_angle = 0.05;    ///< rad
+  /// ctf-icp, uncertain prior: try other coarse starts (identity, half and twice the prior).
+  bool uncertain_starts = true;
+  double uncertain_ndt_scale = 3.0;   ///< the other starts run first on this times ndt_resolution
+  double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
+  /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
+  /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
+  std::uint32_t min_downsampled_points = 1000;
+  int threads = 1;
+  RegistrationOptions registration;  ///< parameters of the frame-to-frame baselines
+};
+
+/// Throws Error naming the first invalid field (unknown method, non-positive sizes, ...).
+void check_odometry_config(const OdometryConfig& config);
+
+/// "ctf-icp, icp, ...": the odometry's methods (ctf-icp and every registration method).
+std::string odometry_method_list();
+/// ctf-icp or a registration method (optional peers: frame_odometry.hpp).
+bool is_odometry_method(const std::string& name);
+
+}  // namespace scanmatch

@@ -1,0 +1,106 @@
+#include "scanmatch/odometry/preprocessor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "scanmatch/geometry/voxel_filter.hpp"
+
+namespace scanmatch {
+namespace {
+
+/// Frames with this many times min_downsampled_points before the voxel filter are dense.
+constexpr std::size_t kDenseFactor = 10;
+
+// The constant-velocity motion over the frame, as a transform into the sensor frame at the
+// reference time `reference` (s after the frame start) for each point time. The transform at each
+// of kBins instants is exact; between them a first-order step (I + ds xi^) is accurate to
+// O(ds^2 |w|^2).
+class Deskew {
+ public:
+  Deskew(const FrameMotion& motion, double max_time, double reference)
+      : xi_(se3_log(motion.motion) / motion.period),
+        angular_(xi_.head<3>().cast<float>()),
+        linear_(xi_.tail<3>().cast<float>()) {
+    step_ = std::max(max_time, 1e-6) / (kBins - 1);
+    for (int k = 0; k < kBins; ++k)
+      bins_[k] = se3_exp(xi_ * (k * step_ - reference)).matrix().cast<float>();
+  }
+  Point apply(const Point& p, float t) const {
+    // Rounding by truncation (not std::lround, a library call per point): equal for t >= 0, and
+    // the clamp maps any negative time to the first bin either way.
+    const int k = std::clamp(static_cast<int>(t / step_ + 0.5), 0, kBins - 1);
+    const float ds = t - static_cast<float>(k * step_);
+    const Point q = p + ds * (angular_.cross(p) + linear_);
+    return bins_[k].topLeftCorner<3, 3>() * q + bins_[k].topRightCorner<3, 1>();
+  }
+
+ private:
+  static constexpr int kBins = 64;
+  Vector6d xi_;                       ///< twist per second
+  Eigen::Vector3f angular_, linear_;  ///< its halves in float, for the per-point step
+  double step_;
+  Eigen::Matrix4f bins_[kBins];
+};
+
+}  // namespace
+
+PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_attributes) {
+  PreprocessOptions o;
+  o.min_range = config.min_range;
+  o.max_range = config.max_range;
+  o.voxel_size = config.voxel_size;
+  o.min_downsampled_points = config.min_downsampled_points;
+  o.keep_attributes = keep_attributes;
+  return o;
+}
+
+PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* motion) const {
+  if (!frame.fields_consistent()) return PointCloud{};
+  const double min2 = options_.min_range * options_.min_range,
+               max2 = options_.max_range * options_.max_range;
+  const bool deskew = motion != nullptr && frame.has_time();
+  std::optional<Deskew> deskewing;
+  if (deskew) {
+    float max_time = 0.0f;
+    for (float t : frame.time)
+      if (std::isfinite(t)) max_time = std::max(max_time, t);
+    deskewing.emplace(*motion, max_time, 0.5 * motion->period);
+  }
+  const bool keep_ring = frame.has_ring() && options_.keep_attributes;
+  const bool keep_intensity = frame.has_intensity() && options_.keep_attributes;
+  PointCloud kept;
+  kept.points.reserve(frame.size());
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    const Point& p = frame.points[i];
+    const double r2 = p.squaredNorm();
+    if (!p.allFinite() || r2 < min2 || r2 > max2) continue;
+    if (deskew && std::isfinite(frame.time[i]))
+      kept.points.push_back(deskewing->apply(p, frame.time[i]));
+    else
+      kept.points.push_back(p);
+    if (keep_ring) kept.ring.push_back(frame.ring[i]);
+    if (keep_intensity) kept.intensity.push_back(frame.intensity[i]);
+  }
+  return adaptive_downsample(kept, frame.size(), options_);
+}
+
+PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
+                               const PreprocessOptions& options) {
+  if (options.voxel_size <= 0.0) return cloud;
+  double voxel = options.voxel_size;
+  PointCloud down = voxel_downsample(cloud, voxel);
+  // Only frames delivered sparse (FAST-LIO keyframes): a dense frame that keeps few points sees a
+  // near wall or is mostly within min_range, and finer voxels there did not help (dynamic-indoor:
+  // 0.1864 -> 0.1878 % ATE when applied to those frames too).
+  if (delivered >= kDenseFactor * options.min_downsampled_points) return down;
+  // Halve the voxel (twice at most) while a sparse frame keeps too few points to register.
+  for (int k = 0;
+       k < 2 && down.size() < options.min_downsampled_points && down.size() < cloud.size(); ++k) {
+    voxel *= 0.5;
+    down = voxel_downsample(cloud, voxel);
+  }
+  return down;
+}
+
+}  // namespace scanmatch

@@ -1,0 +1,57 @@
+#pragma once
+// The first stage of every odometry pipeline (ours and the peers) and of the benchmark's scoring:
+// range crop, deskew, and a voxel filter whose size follows the frame.
+//
+// - Range crop: points nearer than min_range (the robot itself), farther than max_range, or not
+//   finite are dropped.
+// - Deskew: given the frame's motion, each point with a time is moved to the sensor frame at
+//   mid-frame (the reference the registration estimates).
+// - Adaptive voxel filter: voxel_size, and for a sparse frame (delivered with fewer than 10 x
+//   min_downsampled_points points, e.g. FAST-LIO keyframes) that keeps fewer than
+//   min_downsampled_points, smaller voxels (halved at most twice).
+
+#include <cstddef>
+#include <cstdint>
+
+#include "scanmatch/core/point_cloud.hpp"
+#include "scanmatch/core/se3.hpp"
+#include "scanmatch/odometry/odometry_config.hpp"
+
+namespace scanmatch {
+
+/// The sensor's motion over one frame, assumed constant: `motion` over `period` s.
+struct FrameMotion {
+  Pose motion = Pose::Identity();
+  double period = 0.1;
+};
+
+struct PreprocessOptions {
+  double min_range = 0.3, max_range = 100.0;    ///< m
+  double voxel_size = 0.25;                     ///< m (0: no filter)
+  std::uint32_t min_downsampled_points = 1000;  ///< point floor of sparse frames (0: off)
+  /// Keep rings and intensities (feature methods read them); otherwise only positions are kept.
+  bool keep_attributes = true;
+};
+
+/// The preprocessing fields of an odometry configuration.
+PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_attributes);
+
+class Preprocessor {
+ public:
+  explicit Preprocessor(const PreprocessOptions& options) : options_(options) {}
+  /// The frame cropped, deskewed by `motion` (when given; points without a finite time stay as
+  /// they are) and downsampled. Inconsistent fields (a time per point missing) give an empty cloud.
+  PointCloud process(const PointCloud& frame, const FrameMotion* motion = nullptr) const;
+  const PreprocessOptions& options() const { return options_; }
+
+ private:
+  PreprocessOptions options_;
+};
+
+/// The adaptive voxel filter alone: voxel_size, then, for a frame delivered with fewer than
+/// 10 x min_downsampled_points points (`delivered`, before the range crop), smaller voxels while
+/// fewer than min_downsampled_points remain (at most down to voxel_size / 4).
+PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
+                               const PreprocessOptions& options);
+
+}  // namespace scanmatch
