@@ -9,6 +9,8 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
+#include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/odometry_pipeline.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
 
@@ -71,8 +73,10 @@ TEST(Peers, OurOdometryThroughTheInterfaceGivesTheSamePoses) {
     Pose world_from_frame;
     const PointCloud* last = through->last_map_frame(world_from_frame);
     ASSERT_NE(last, nullptr);
-    EXPECT_EQ(last->size(), direct.last_frame().size());
-    EXPECT_TRUE(world_from_frame.isApprox(direct.world_from_map() * direct.last_internal_pose()));
+    const OdometryPipeline& pipeline = direct.pipeline();
+    EXPECT_EQ(last->size(), pipeline.last_frame().size());
+    EXPECT_TRUE(
+        world_from_frame.isApprox(pipeline.world_from_internal() * pipeline.last_internal_pose()));
   }
 }
 
