@@ -3,7 +3,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "scanmatch/core/error.hpp"
 
@@ -19,51 +18,18 @@ GaussianVoxelMap::GaussianVoxelMap(const GaussianVoxelMapOptions& options) : opt
 }
 
 const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {
-  const std::int32_t slot = lookup(index_of(p));
+  const std::int32_t slot = voxels_.find(index_of(p));
   if (slot < 0) return nullptr;
-  const GaussianVoxel& v = voxels_[static_cast<std::size_t>(slot)];
+  const GaussianVoxel& v = voxels_.value(static_cast<std::size_t>(slot));
   return v.count >= options_.min_points ? &v : nullptr;
-}
-
-void GaussianVoxelMap::rebuild_table(std::size_t capacity) {
-  std::size_t size = 16;
-  while (size < 2 * capacity) size *= 2;
-  table_.assign(size, Slot{});
-  const std::size_t mask = size - 1;
-  for (std::size_t i = 0; i < indices_.size(); ++i) {
-    std::size_t slot = VoxelKeyHash{}(indices_[i]) & mask;
-    while (table_[slot].at >= 0) slot = (slot + 1) & mask;
-    table_[slot] = Slot{indices_[i], static_cast<std::int32_t>(i)};
-  }
-}
-
-std::size_t GaussianVoxelMap::lookup_or_create(const VoxelKey& index) {
-  if (2 * (voxels_.size() + 1) > table_.size()) rebuild_table(2 * (voxels_.size() + 1));
-  const std::size_t mask = table_.size() - 1;
-  std::size_t slot = VoxelKeyHash{}(index)&mask;
-  for (;; slot = (slot + 1) & mask) {
-    const Slot& s = table_[slot];
-    if (s.at < 0) break;
-    if (s.key == index) return static_cast<std::size_t>(s.at);
-  }
-  if (voxels_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
-    throw Error("Gaussian voxel map: too many voxels");
-  table_[slot] = Slot{index, static_cast<std::int32_t>(voxels_.size())};
-  voxels_.emplace_back();
-  indices_.push_back(index);
-  return voxels_.size() - 1;
 }
 
 void GaussianVoxelMap::reserve(std::size_t voxels) {
   voxels_.reserve(voxels);
-  indices_.reserve(voxels);
-  if (2 * voxels > table_.size()) rebuild_table(voxels);
 }
 
 void GaussianVoxelMap::clear() {
   voxels_.clear();
-  indices_.clear();
-  std::fill(table_.begin(), table_.end(), Slot{});
 }
 
 void GaussianVoxelMap::merge(GaussianVoxel& v, std::uint32_t n, const Eigen::Vector3d& mean,
@@ -120,8 +86,8 @@ std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) 
     const Eigen::Vector3d p = pose * point.cast<double>();
     if (!p.allFinite()) continue;
     const VoxelKey index = index_of(p);
-    const std::size_t at = lookup_or_create(index);
-    GaussianVoxel& v = voxels_[at];
+    const std::size_t at = voxels_.find_or_insert(index).entry;
+    GaussianVoxel& v = voxels_.value(at);
     if (options_.max_points > 0 && v.count >= options_.max_points) continue;
     const Eigen::Vector3d local =
         p - Eigen::Vector3d(index.x, index.y, index.z) * options_.voxel_size;
@@ -135,9 +101,9 @@ std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) 
   }
   std::size_t merged = 0;
   for (const std::size_t at : touched) {
-    GaussianVoxel& v = voxels_[at];
+    GaussianVoxel& v = voxels_.value(at);
     if (v.pending >= options_.merge_threshold) {
-      merge_pending(indices_[at], v);
+      merge_pending(voxels_.keys()[at], v);
       ++merged;
     }
   }
@@ -145,33 +111,19 @@ std::size_t GaussianVoxelMap::insert(const PointCloud& cloud, const Pose& pose) 
 }
 
 void GaussianVoxelMap::flush() {
-  for (std::size_t i = 0; i < voxels_.size(); ++i) merge_pending(indices_[i], voxels_[i]);
+  for (std::size_t i = 0; i < voxels_.size(); ++i)
+    merge_pending(voxels_.keys()[i], voxels_.value(i));
 }
 
 std::size_t GaussianVoxelMap::remove_far(const Eigen::Vector3d& center, double radius) {
   const double r2 = radius * radius;
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < voxels_.size(); ++i) {
-    const GaussianVoxel& v = voxels_[i];
-    const VoxelKey& k = indices_[i];
+  return voxels_.remove_if([&](const VoxelKey& k, const GaussianVoxel& v) {
     const Eigen::Vector3d where =
         v.count > 0 ? v.mean
                     : (Eigen::Vector3d(k.x, k.y, k.z) + Eigen::Vector3d::Constant(0.5)) *
                           options_.voxel_size;
-    if ((where - center).squaredNorm() > r2) continue;
-    if (kept != i) {
-      voxels_[kept] = std::move(voxels_[i]);
-      indices_[kept] = indices_[i];
-    }
-    ++kept;
-  }
-  const std::size_t removed = voxels_.size() - kept;
-  if (removed > 0) {
-    voxels_.resize(kept);
-    indices_.resize(kept);
-    rebuild_table(kept);
-  }
-  return removed;
+    return (where - center).squaredNorm() > r2;
+  });
 }
 
 }  // namespace scanmatch

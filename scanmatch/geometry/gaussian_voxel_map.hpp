@@ -12,6 +12,7 @@
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/core/se3.hpp"
+#include "scanmatch/geometry/voxel_hash.hpp"
 #include "scanmatch/geometry/voxel_key.hpp"
 
 namespace scanmatch {
@@ -51,7 +52,7 @@ inline Eigen::Matrix3d planar_information(const GaussianVoxel& voxel, double eps
 struct VoxelHint {
   static constexpr std::int32_t kUnknown = -2;
   VoxelKey key;
-  std::int32_t slot = kUnknown;  ///< position in the map's voxels, -1: no voxel
+  std::int32_t slot = kUnknown;  ///< position in the map's voxels(), -1: no voxel
 };
 
 struct GaussianVoxelMapOptions {
@@ -96,9 +97,10 @@ class GaussianVoxelMap {
   /// are in use.
   const GaussianVoxel* find(const Eigen::Vector3d& p, VoxelHint& hint) const {
     const VoxelKey key = index_of(p);
-    if (hint.slot == VoxelHint::kUnknown || !(hint.key == key)) hint = VoxelHint{key, lookup(key)};
+    if (hint.slot == VoxelHint::kUnknown || !(hint.key == key))
+      hint = VoxelHint{key, voxels_.find(key)};
     if (hint.slot < 0) return nullptr;
-    const GaussianVoxel& v = voxels_[static_cast<std::size_t>(hint.slot)];
+    const GaussianVoxel& v = voxels_.value(static_cast<std::size_t>(hint.slot));
     return v.count >= options_.min_points ? &v : nullptr;
   }
   /// For a loop over points i with hints (find(position_of(i), hints[i])): at point i, resolves
@@ -109,14 +111,13 @@ class GaussianVoxelMap {
   void prefetch_ahead(std::size_t i, std::size_t end, std::span<VoxelHint> hints,
                       PositionOf&& position_of) const {
     constexpr std::size_t kNear = 8, kFar = 16;
-    if (table_.empty()) return;
+    if (voxels_.empty()) return;
     if (i + kFar < end && hints[i + kFar].slot == VoxelHint::kUnknown)
-      __builtin_prefetch(
-          &table_[VoxelKeyHash{}(index_of(position_of(i + kFar))) & (table_.size() - 1)]);
+      voxels_.prefetch(index_of(position_of(i + kFar)));
     if (i + kNear < end) {
       VoxelHint& ahead = hints[i + kNear];
       if (ahead.slot == VoxelHint::kUnknown) find(position_of(i + kNear), ahead);
-      if (ahead.slot >= 0) __builtin_prefetch(&voxels_[static_cast<std::size_t>(ahead.slot)]);
+      if (ahead.slot >= 0) __builtin_prefetch(&voxels_.value(static_cast<std::size_t>(ahead.slot)));
     }
   }
   /// Calls f(voxel) for the usable voxels among p's voxel and its 6 (neighbours = 7) or 26
@@ -142,9 +143,10 @@ class GaussianVoxelMap {
     const VoxelKey c = index_of(p);
     int found = 0;
     for (const auto& o : offsets(neighbours)) {
-      const std::int32_t slot = lookup(VoxelKey{c.x + o[0], c.y + o[1], c.z + o[2]});
-      if (slot >= 0 && voxels_[static_cast<std::size_t>(slot)].count >= options_.min_points)
-        out[found++] = &voxels_[static_cast<std::size_t>(slot)];
+      const std::int32_t slot = voxels_.find(VoxelKey{c.x + o[0], c.y + o[1], c.z + o[2]});
+      if (slot < 0) continue;
+      const GaussianVoxel& v = voxels_.value(static_cast<std::size_t>(slot));
+      if (v.count >= options_.min_points) out[found++] = &v;
     }
     return found;
   }
@@ -152,8 +154,8 @@ class GaussianVoxelMap {
   std::size_t size() const { return voxels_.size(); }
   const GaussianVoxelMapOptions& options() const { return options_; }
   /// Every voxel (usable or not) and its index, in parallel, in no particular order.
-  const std::vector<GaussianVoxel>& voxels() const { return voxels_; }
-  const std::vector<VoxelKey>& indices() const { return indices_; }
+  const std::vector<GaussianVoxel>& voxels() const { return voxels_.values(); }
+  const std::vector<VoxelKey>& indices() const { return voxels_.keys(); }
 
   /// The merge of docs/methods.md: (m, mu1, C1) + (n, mu2, C2) with the outer-product cross term.
   static void merge(GaussianVoxel& voxel, std::uint32_t n, const Eigen::Vector3d& mean,
@@ -179,33 +181,12 @@ class GaussianVoxelMap {
   }
   void merge_pending(const VoxelKey& index, GaussianVoxel& voxel);
   void update_cache(GaussianVoxel& voxel) const;
-  /// Position of the voxel in voxels_, or -1. The slot holds the key itself, so a probe reads one
-  /// cache line of the table and nothing else.
-  std::int32_t lookup(const VoxelKey& index) const {
-    if (table_.empty()) return -1;
-    const std::size_t mask = table_.size() - 1;
-    for (std::size_t slot = VoxelKeyHash{}(index)&mask;; slot = (slot + 1) & mask) {
-      const Slot& s = table_[slot];
-      if (s.at < 0 || s.key == index) return s.at;
-    }
-  }
-  /// Position of the voxel, created when absent.
-  std::size_t lookup_or_create(const VoxelKey& index);
-  void rebuild_table(std::size_t capacity);
 
   GaussianVoxelMapOptions options_;
   double inverse_size_ = 1.0;
   bool exact_inverse_ = false;  ///< 1 / voxel size is exact (a power of two)
   std::uint64_t insert_calls_ = 0;
-  // Open addressing with linear probing: table_ holds keys and positions into the dense arrays
-  // (at < 0: empty), at most half full. Dense storage keeps iteration and removal cheap.
-  struct Slot {
-    VoxelKey key;
-    std::int32_t at = -1;
-  };
-  std::vector<GaussianVoxel> voxels_;
-  std::vector<VoxelKey> indices_;
-  std::vector<Slot> table_;
+  VoxelHashTable<GaussianVoxel> voxels_;
 };
 
 }  // namespace scanmatch

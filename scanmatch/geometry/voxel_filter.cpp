@@ -8,80 +8,28 @@
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/voxel_hash.hpp"
 #include "scanmatch/geometry/voxel_key.hpp"
 
 namespace scanmatch {
 namespace {
 
-// Open addressing with linear probing over 16-byte entries (key and dense voxel index side by
-// side). The table is sized by the number of voxels, not points, and grows at half load, so for a
-// typical frame it stays in L2 cache.
-class VoxelSlots {
- public:
-  static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
-
-  /// Empties the table, sized for about `expected` voxels (it still grows when needed); keeps
-  /// the allocation between calls, but never a table much larger than the work at hand.
-  void reset(std::size_t expected) {
-    std::size_t capacity = kInitialCapacity;
-    while (capacity < 2 * expected) capacity <<= 1;
-    entries_.assign(capacity, Entry{{0, 0, 0}, kEmpty});
-    size_ = 0;
-  }
-
-  /// Returns the voxel's dense index, creating it (index = count so far) when new.
-  std::uint32_t find_or_insert(const VoxelKey& key) {
-    const std::size_t mask = entries_.size() - 1;
-    std::size_t i = VoxelKeyHash{}(key)&mask;
-    while (true) {
-      Entry& e = entries_[i];
-      if (e.index == kEmpty) {
-        e.key = key;
-        e.index = size_++;
-        if (2 * size_ > entries_.size()) grow();
-        return size_ - 1;
-      }
-      if (e.key == key) return e.index;
-      i = (i + 1) & mask;
-    }
-  }
-
- private:
-  struct Entry {
-    VoxelKey key;
-    std::uint32_t index;
-  };
-  static constexpr std::size_t kInitialCapacity = 4096;
-
-  void grow() {
-    std::vector<Entry> old(2 * entries_.size(), Entry{{0, 0, 0}, kEmpty});
-    old.swap(entries_);
-    const std::size_t mask = entries_.size() - 1;
-    for (const Entry& e : old) {
-      if (e.index == kEmpty) continue;
-      std::size_t i = VoxelKeyHash{}(e.key) & mask;
-      while (entries_[i].index != kEmpty) i = (i + 1) & mask;
-      entries_[i] = e;
-    }
-  }
-
-  std::vector<Entry> entries_;
-  std::uint32_t size_ = 0;
-};
-
 struct Accumulator {
-  Eigen::Vector3d sum;
-  std::uint32_t count;
-  std::uint32_t first;  // index of the first point met in this voxel
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::uint32_t count = 0;
+  std::uint32_t first = 0;  // index of the first point met in this voxel
 };
 
 // Per-thread scratch reused across calls: fresh multi-megabyte buffers on every frame cost more in
 // page faults than the downsampling itself.
 struct Workspace {
   std::vector<std::uint32_t> voxel_of_point;
-  VoxelSlots slots;
-  std::vector<Accumulator> voxels;
+  VoxelHashTable<Accumulator> voxels;
 };
+
+// The table is sized for at least this many voxels (4096 slots of 16 bytes): small frames never
+// grow it, and it stays in L2 cache.
+constexpr std::size_t kMinimumExpectedVoxels = 2048;
 
 constexpr std::uint32_t kSkipped = std::numeric_limits<std::uint32_t>::max();
 
@@ -98,12 +46,10 @@ PointCloud voxel_downsample(const PointCloud& cloud, double voxel_size, VoxelRed
 
   thread_local Workspace workspace;
   std::vector<std::uint32_t>& voxel_of_point = workspace.voxel_of_point;
-  std::vector<Accumulator>& voxels = workspace.voxels;
-  VoxelSlots& slots = workspace.slots;
+  VoxelHashTable<Accumulator>& table = workspace.voxels;
   voxel_of_point.resize(n);
   // The previous call's voxel count is the best guess for this one (consecutive frames).
-  slots.reset(voxels.size());
-  voxels.clear();
+  table.reset(std::max(table.size(), kMinimumExpectedVoxels));
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3f s = cloud.points[i] * inv;
     if (!s.allFinite()) {
@@ -114,13 +60,14 @@ PointCloud voxel_downsample(const PointCloud& cloud, double voxel_size, VoxelRed
       fail("voxel_downsample", "point " + std::to_string(i) +
                                    " is too far from the origin for voxel size " +
                                    std::to_string(voxel_size));
-    const std::uint32_t v = slots.find_or_insert(voxel_key_scaled(s));
-    if (v == voxels.size())
-      voxels.push_back(Accumulator{Eigen::Vector3d::Zero(), 0, static_cast<std::uint32_t>(i)});
-    voxels[v].sum += cloud.points[i].cast<double>();
-    ++voxels[v].count;
-    voxel_of_point[i] = v;
+    const auto [v, inserted] = table.find_or_insert(voxel_key_scaled(s));
+    Accumulator& voxel = table.value(v);
+    if (inserted) voxel.first = static_cast<std::uint32_t>(i);
+    voxel.sum += cloud.points[i].cast<double>();
+    ++voxel.count;
+    voxel_of_point[i] = static_cast<std::uint32_t>(v);
   }
+  const std::vector<Accumulator>& voxels = table.values();
 
   PointCloud out;
   const std::size_t m = voxels.size();

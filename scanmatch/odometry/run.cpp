@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <unordered_set>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/eval/metrics_json.hpp"
+#include "scanmatch/geometry/voxel_hash.hpp"
 #include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
@@ -53,7 +53,7 @@ class PointMap {
   void add(const PointCloud& cloud, const Pose& pose) {
     for (const Point& p : cloud.points) {
       const Eigen::Vector3d w = pose * p.cast<double>();
-      if (cells_.insert(voxel_key(w, voxel_)).second) points_.push_back(w.cast<float>());
+      if (cells_.find_or_insert(voxel_key(w, voxel_)).inserted) points_.push_back(w.cast<float>());
     }
   }
   void keep_within(const Eigen::Vector3d& center, double radius) {
@@ -62,7 +62,7 @@ class PointMap {
     cells_.clear();
     for (const Point& p : points_) {
       if ((p.cast<double>() - center).squaredNorm() > r2) continue;
-      cells_.insert(voxel_key(p.cast<double>(), voxel_));
+      cells_.find_or_insert(voxel_key(p.cast<double>(), voxel_));
       kept.push_back(p);
     }
     points_.swap(kept);
@@ -75,7 +75,7 @@ class PointMap {
 
  private:
   double voxel_;
-  std::unordered_set<VoxelKey, VoxelKeyHash> cells_;
+  VoxelSet cells_;
   std::vector<Point> points_;
 };
 

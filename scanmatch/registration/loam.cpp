@@ -37,9 +37,10 @@ RegistrationResult register_loam_features(const LoamFeatures& source, const Loam
     throw Error("loam: too few planar features (source " + std::to_string(source.planes.size()) +
                 ", target " + std::to_string(target.planes.size()) + ")");
   const KdTree edge_tree(target.edges.points), plane_tree(target.planes.points);
-  const LoamEdgeFactor edges{source.edges, target.edges, edge_tree, o.max_correspondence_distance};
-  const LoamPlaneFactor planes{source.planes, target.planes, plane_tree,
-                               o.max_correspondence_distance};
+  const LoamEdgeFactor edges{
+      {source.edges, target.edges, edge_tree, o.max_correspondence_distance}};
+  const LoamPlaneFactor planes{
+      {source.planes, target.planes, plane_tree, o.max_correspondence_distance}};
   return optimize(LoamCombinedFactor{use_edges ? &edges : nullptr, use_planes ? &planes : nullptr},
                   initial, o.solver);
 }

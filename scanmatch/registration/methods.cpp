@@ -73,22 +73,23 @@ RegistrationResult point_to_plane(const PointCloud& s, const PointCloud& t, cons
                                   const Pose& T) {
   const KdTree tree(t.points);
   const auto normals = estimate_normals(t, tree, o.normal_neighbours, o.solver.num_threads);
-  return optimize(PointToPlaneFactor{s, t, tree, normals, o.max_correspondence_distance}, T,
+  return optimize(PointToPlaneFactor{{s, t, tree, o.max_correspondence_distance}, normals}, T,
                   o.solver);
 }
 
 RegistrationResult point_to_line(const PointCloud& s, const PointCloud& t, const Options& o,
                                  const Pose& T) {
   const KdTree tree(t.points);
-  return optimize(PointToLineFactor{s, t, tree, o.max_correspondence_distance}, T, o.solver);
+  return optimize(PointToLineFactor{{s, t, tree, o.max_correspondence_distance}}, T, o.solver);
 }
 
 RegistrationResult gicp(const PointCloud& s, const PointCloud& t, const Options& o, const Pose& T) {
   const KdTree target_tree(t.points), source_tree(s.points);
   const auto target_covariances = regularised_covariances(t, target_tree, o);
   const auto source_covariances = regularised_covariances(s, source_tree, o);
-  return optimize(GicpFactor{s, t, target_tree, source_covariances, target_covariances,
-                             o.max_correspondence_distance},
+  return optimize(GicpFactor{{s, t, target_tree, o.max_correspondence_distance},
+                             source_covariances,
+                             target_covariances},
                   T, o.solver);
 }
 

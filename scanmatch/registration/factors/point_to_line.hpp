@@ -2,8 +2,7 @@
 // Point-to-line (Censi's PL-ICP in 3D): the distance from T p to the line through the two nearest
 // target points. add_point_to_line is shared with LOAM's edge factor.
 
-#include "scanmatch/core/point_cloud.hpp"
-#include "scanmatch/geometry/kdtree.hpp"
+#include "scanmatch/registration/factors/correspondence.hpp"
 #include "scanmatch/registration/solver.hpp"
 
 namespace scanmatch {
@@ -19,21 +18,14 @@ inline bool add_point_to_line(const Pose& T, const Eigen::Vector3d& p, const Eig
   return true;
 }
 
-struct PointToLineFactor {
-  const PointCloud& source;
-  const PointCloud& target;
-  const KdTree& tree;
-  double max_distance;
-  std::size_t size() const { return source.size(); }
+struct PointToLineFactor : NearestTargetSearch {
   bool linearize(const Pose& T, std::size_t i, LinearSystem& system,
                  const RobustKernel& kernel) const {
-    const Eigen::Vector3d p = source.points[i].cast<double>(), x = T * p;
-    std::size_t idx[2];
-    float d2[2];
-    if (tree.knn(x.cast<float>(), 2, idx, d2) < 2 || d2[0] > max_distance * max_distance)
-      return false;
-    const Eigen::Vector3d q1 = target.points[idx[0]].cast<double>();
-    return add_point_to_line(T, p, q1, target.points[idx[1]].cast<double>() - q1, system, kernel);
+    NearestTargets<2> near;
+    if (!search(T, i, near)) return false;
+    const Eigen::Vector3d q1 = target.points[near.index[0]].cast<double>();
+    return add_point_to_line(T, near.p, q1, target.points[near.index[1]].cast<double>() - q1,
+                             system, kernel);
   }
 };
 
