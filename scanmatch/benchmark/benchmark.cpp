@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/eval/report.hpp"
+#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/file_util.hpp"

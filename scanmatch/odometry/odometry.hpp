@@ -20,6 +20,7 @@
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"
 #include "scanmatch/odometry/adaptive_state.hpp"
+#include "scanmatch/odometry/frame_stats.hpp"
 #include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
@@ -84,15 +85,6 @@ struct OdometryConfig {
   std::uint32_t min_downsampled_points = 1000;
   int threads = 1;
   RegistrationOptions registration;  ///< parameters of the frame-to-frame baselines
-};
-
-struct FrameStats {
-  double preprocess_ms = 0, coarse_ms = 0, fine_ms = 0, map_ms = 0, total_ms = 0;
-  std::size_t points_in = 0, points_downsampled = 0;
-  int iterations = 0;             ///< coarse plus fine
-  double condition_number = 0;    ///< of the last stage's information matrix
-  int degenerate_directions = 0;  ///< directions the fine stage left at the motion prior
-  bool bridged = false;           ///< the frame could not be registered: the motion prior was used
 };
 
 /// "ctf-icp, icp, ...": the odometry's methods (ctf-icp and every registration method).
