@@ -38,7 +38,9 @@ struct CsvCells {
   }
 };
 
-std::vector<std::string> split_cells(const std::string& line) {
+// The cells of a line (a CRLF file's '\r' dropped).
+std::vector<std::string> split_cells(std::string line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
   std::vector<std::string> cells;
   std::istringstream in(line);
   for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
@@ -96,7 +98,8 @@ struct StageSums {
 
 std::string timing_csv_header() {
   CsvKeys keys;
-  describe(static_cast<const FrameStats&>(FrameStats{}), keys);
+  const FrameStats defaults;
+  describe(defaults, keys);
   return keys.line;
 }
 
@@ -115,7 +118,7 @@ std::vector<FrameRecord> read_timing_csv(const std::string& path) {
     fail(path, "line 1", "no total_ms column");
   std::vector<FrameRecord> rows;
   for (std::size_t number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
+    if (line.empty() || line == "\r") continue;
     const std::string where = "line " + std::to_string(number);
     const std::vector<std::string> cells = split_cells(line);
     if (cells.size() != header.size())
@@ -134,7 +137,8 @@ std::vector<FrameRecord> read_timing_csv(const std::string& path) {
 
 std::vector<StageStatistics> stage_statistics(const std::vector<FrameStats>& frames) {
   StageSums sum;
-  describe(static_cast<const FrameStats&>(FrameStats{}), sum);  // the names, also without frames
+  const FrameStats defaults;
+  describe(defaults, sum);  // the names, also without frames
   for (const FrameStats& frame : frames) {
     sum.next = 0;
     describe(frame, sum);
