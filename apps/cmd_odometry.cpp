@@ -65,11 +65,11 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
   if (!c.quiet) {
     std::printf("%s on %s: %zu frames, %.1f frames/s (pipeline %.2f ms/frame mean, %.2f max)%s\n",
                 summary.method.c_str(), summary.source.c_str(), summary.frames,
-                summary.frames_per_second, summary.total.mean_ms, summary.total.max_ms,
-                summary.interrupted ? ", interrupted" : "");
+                summary.frames_per_second, summary.stage("total").mean_ms,
+                summary.stage("total").max_ms, summary.interrupted ? ", interrupted" : "");
     std::printf("stages (mean ms): preprocess %.2f, coarse %.2f, fine %.2f, map update %.2f\n",
-                summary.preprocess.mean_ms, summary.coarse.mean_ms, summary.fine.mean_ms,
-                summary.map_update.mean_ms);
+                summary.stage("preprocess").mean_ms, summary.stage("coarse").mean_ms,
+                summary.stage("fine").mean_ms, summary.stage("map_update").mean_ms);
     if (summary.bridged_frames > 0)
       std::printf("%zu frames bridged by the motion prior\n", summary.bridged_frames);
     if (!accuracy.empty()) std::printf("%s\n", accuracy.c_str());

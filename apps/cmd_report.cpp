@@ -2,7 +2,7 @@
 
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/eval/report.hpp"
+#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/io/file_util.hpp"
 
 namespace scanmatch::cli {

@@ -17,14 +17,10 @@
 
 namespace scanmatch {
 namespace {
+using scanmatch::testing::read_text;
 using scanmatch::testing::run_cli;
 using scanmatch::testing::TempDir;
 using namespace scanmatch::test;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 /// A PointCloud2 holding exactly the cloud's values (float x y z intensity time, u16 ring).
 std::string cloud_message(const PointCloud& cloud, std::int64_t stamp_ns) {

@@ -11,14 +11,10 @@
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::read_text;
 using scanmatch::testing::TempDir;
 
 namespace {
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 const ResultTable* table_titled(const std::vector<ResultTable>& tables, const std::string& start) {
   for (const ResultTable& t : tables)

@@ -20,6 +20,7 @@
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::read_text;
 using scanmatch::testing::run_cli;
 using scanmatch::testing::TempDir;
 
@@ -29,10 +30,6 @@ std::size_t count_lines(const std::string& path) {
   std::size_t n = 0;
   for (std::string line; std::getline(in, line);) n += !line.empty();
   return n;
-}
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 }  // namespace
 

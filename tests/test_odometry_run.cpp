@@ -1,9 +1,9 @@
 // The run folder written by run_odometry: the ground truth beside the poses and the ATE in the
-// summary, both from the source alone.
+// summary, both from the source alone; every described frame statistic in timing.csv and
+// summary.json.
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "scanmatch/eval/metrics.hpp"
@@ -13,13 +13,13 @@
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::read_text;
 using scanmatch::testing::TempDir;
 
 namespace {
 
 nlohmann::json read_json(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
+  return nlohmann::json::parse(read_text(path));
 }
 
 // Simulated frames without their ground truth.
@@ -34,18 +34,25 @@ class FramesOnly : public SequenceSource {
   std::unique_ptr<SequenceSource> inner_;
 };
 
+// Runs the defaults on `max_frames` (0: all) of `frames` simulated frames of `preset` into `out`.
+RunSummary run_simulated(const std::string& preset, int frames, std::size_t max_frames,
+                         const std::string& out) {
+  sim::SimOptions sim;
+  sim.frames = frames;
+  const auto source = sim::open_sequence("sim:" + preset, sim);
+  RunOptions options;
+  options.out_dir = out;
+  options.max_frames = max_frames;
+  options.quiet = true;
+  return run_odometry(*source, OdometryConfig{}, options);
+}
+
 }  // namespace
 
 TEST(OdometryRun, WritesTheGroundTruthOfTheFramesRunAndItsAte) {
   TempDir dir;
-  sim::SimOptions sim;
-  sim.frames = 8;
-  const auto source = sim::open_sequence("sim:dynamic-outdoor-fast", sim);
-  RunOptions options;
-  options.out_dir = dir.file("run");
-  options.max_frames = 6;  // fewer than the source has: the ground truth follows the run
-  options.quiet = true;
-  const RunSummary summary = run_odometry(*source, OdometryConfig{}, options);
+  // Fewer frames run than the source has: the ground truth follows the run.
+  const RunSummary summary = run_simulated("dynamic-outdoor-fast", 8, 6, dir.file("run"));
   ASSERT_EQ(summary.frames, 6u);
   ASSERT_TRUE(summary.ate.has_value());
   EXPECT_EQ(summary.ground_truth.size(), 6u);
@@ -87,4 +94,31 @@ TEST(OdometryRun, WithoutGroundTruthThereIsNoneBesideThePoses) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("run/poses_gt.txt")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("run/poses_gt_tum.txt")));
   EXPECT_FALSE(read_json(dir.file("run/summary.json")).contains("ate"));
+}
+
+// Every field and stage of the description (frame_stats.hpp) reaches timing.csv and summary.json.
+TEST(OdometryRun, TimingAndSummaryHoldEveryDescribedFieldAndStage) {
+  TempDir dir;
+  const RunSummary summary = run_simulated("static-indoor", 3, 0, dir.file("run"));
+  ASSERT_EQ(summary.frames, 3u);
+  EXPECT_EQ(read_text(dir.file("run/timing.csv")).substr(0, timing_csv_header().size() + 1),
+            timing_csv_header() + "\n");
+  const std::vector<FrameRecord> rows = read_timing_csv(dir.file("run/timing.csv"));
+  ASSERT_EQ(rows.size(), 3u);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].index, i);
+    EXPECT_EQ(timing_csv_row(i, rows[i].timestamp, rows[i].stats),
+              timing_csv_row(i, rows[i].timestamp, summary.stats[i]));
+  }
+
+  const auto json = nlohmann::ordered_json::parse(read_text(dir.file("run/summary.json")));
+  std::vector<std::string> stages;
+  for (const auto& [name, value] : json["stages"].items()) {
+    stages.push_back(name);
+    EXPECT_EQ(value["max_ms"].get<double>(), summary.stage(name).max_ms);
+  }
+  std::vector<std::string> described;
+  for (const StageStatistics& s : stage_statistics({})) described.push_back(s.name);
+  EXPECT_EQ(stages, described);
+  EXPECT_THROW(summary.stage("no-such-stage"), std::out_of_range);
 }

@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/eval/report.hpp"
+#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/eval/table.hpp"
 #include "test_helpers.hpp"

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <optional>
+#include <string>
 
 #include "bindings.hpp"
 #include "convert.hpp"
@@ -62,20 +63,24 @@ class PyOdometry {
   std::vector<FrameStats> stats_;
 };
 
+// Every field of the description (frame_stats.hpp) by its key.
 py::dict stats_dict(const FrameStats& s) {
   py::dict d;
-  d["preprocess_ms"] = s.preprocess_ms;
-  d["coarse_ms"] = s.coarse_ms;
-  d["fine_ms"] = s.fine_ms;
-  d["map_ms"] = s.map_ms;
-  d["total_ms"] = s.total_ms;
-  d["points_in"] = s.points_in;
-  d["points_downsampled"] = s.points_downsampled;
-  d["iterations"] = s.iterations;
-  d["condition_number"] = s.condition_number;
-  d["degenerate_directions"] = s.degenerate_directions;
-  d["bridged"] = s.bridged;
+  for_each_field(s, [&](const char* key, const auto& field, const char*) { d[key] = field; });
   return d;
+}
+
+// The docstring of last_stats: each key with its help text.
+const char* stats_doc() {
+  static const std::string doc = [] {
+    std::string text = "timing and diagnostics of the last frame (dict), None before the first:";
+    const FrameStats defaults;
+    for_each_field(defaults, [&](const char* key, const auto&, const char* help) {
+      text += std::string("\n  ") + key + ": " + help;
+    });
+    return text;
+  }();
+  return doc.c_str();
 }
 
 }  // namespace
@@ -127,7 +132,7 @@ bad shapes raise ValueError.)doc")
             if (o.stats().empty()) return py::none();
             return stats_dict(o.stats().back());
           },
-          "timing and diagnostics of the last frame (dict), None before the first")
+          stats_doc())
       .def_property_readonly(
           "stats",
           [](const PyOdometry& o) {

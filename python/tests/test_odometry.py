@@ -40,12 +40,23 @@ class OdometrySimulated(unittest.TestCase):
         self.assertLess(ate["rmse"], CLI_ATE_RMSE)
 
     @unittest.skipUnless(os.environ.get("SCANMATCH_CLI"), "SCANMATCH_CLI not set")
-    def test_same_poses_as_the_cli(self):
+    def test_same_poses_and_statistics_as_the_cli(self):
         with tempfile.TemporaryDirectory() as out:
             subprocess.run([os.environ["SCANMATCH_CLI"], "odometry", f"sim:{PRESET}", "--frames",
                             str(FRAMES), "--seed", str(SEED), "--out", out, "--quiet"], check=True)
             cli = np.loadtxt(os.path.join(out, "poses.txt")).reshape(-1, 3, 4)
+            with open(os.path.join(out, "timing.csv")) as timing:
+                columns = timing.readline().strip().split(",")
         np.testing.assert_allclose(self.odometry.poses[:, :3, :], cli, atol=1e-8)
+        # One description gives both: the dictionary keys are timing.csv's columns, in order.
+        self.assertEqual(columns[:2], ["index", "timestamp"])
+        self.assertEqual(list(self.odometry.stats[0]), columns[2:])
+        self.assertEqual(list(self.odometry.last_stats), columns[2:])
+
+    def test_statistics_are_documented(self):
+        doc = type(self.odometry).last_stats.__doc__
+        for key in self.odometry.last_stats:
+            self.assertIn(f"\n  {key}: ", doc)
 
 
 class OdometryConfiguration(unittest.TestCase):

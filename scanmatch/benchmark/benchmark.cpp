@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/eval/report.hpp"
+#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"

@@ -87,12 +87,13 @@ std::vector<ResultTable> benchmark_tables(const std::vector<BenchmarkSequence>& 
     for (const auto& s : c->run.stats)
       points +=
           static_cast<double>(s.points_downsampled) / static_cast<double>(c->run.stats.size());
-    stages.rows.push_back(
-        {r.name, fmt::format("{:.2f}", c->run.preprocess.mean_ms),
-         fmt::format("{:.2f}", c->run.coarse.mean_ms), fmt::format("{:.2f}", c->run.fine.mean_ms),
-         fmt::format("{:.2f}", c->run.map_update.mean_ms),
-         fmt::format("{:.2f}", c->run.total.mean_ms), fmt::format("{:.1f}", c->run.total.max_ms),
-         fmt::format("{:.0f}", points)});
+    stages.rows.push_back({r.name, fmt::format("{:.2f}", c->run.stage("preprocess").mean_ms),
+                           fmt::format("{:.2f}", c->run.stage("coarse").mean_ms),
+                           fmt::format("{:.2f}", c->run.stage("fine").mean_ms),
+                           fmt::format("{:.2f}", c->run.stage("map_update").mean_ms),
+                           fmt::format("{:.2f}", c->run.stage("total").mean_ms),
+                           fmt::format("{:.1f}", c->run.stage("total").max_ms),
+                           fmt::format("{:.0f}", points)});
   }
   if (!stages.rows.empty()) tables.push_back(stages);
 
@@ -127,11 +128,12 @@ std::vector<ResultTable> benchmark_tables(const std::vector<BenchmarkSequence>& 
           {r.name, m,
            cell_text(
                c, [](const BenchmarkCell& x) { return fmt::format("{:.4f}", x.accuracy_score); }),
-           cell_text(
-               c,
-               [](const BenchmarkCell& x) { return fmt::format("{:.1f}", x.run.total.mean_ms); }),
+           cell_text(c,
+                     [](const BenchmarkCell& x) {
+                       return fmt::format("{:.1f}", x.run.stage("total").mean_ms);
+                     }),
            cell_text(c, [](const BenchmarkCell& x) {
-             return fmt::format("{:.1f}", x.run.total.max_ms);
+             return fmt::format("{:.1f}", x.run.stage("total").max_ms);
            })});
     }
   tables.push_back(loam);

@@ -1,8 +1,5 @@
 #include "scanmatch/io/trajectory.hpp"
 
-#include <cerrno>
-#include <cstring>
-
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/parse_util.hpp"
@@ -14,18 +11,19 @@ using namespace io_detail;
 // Rotation blocks off by more than this are refused rather than silently re-orthonormalised.
 constexpr double kRotationTolerance = 1e-3;
 
+// One pose's line, without the newline.
 std::string format_line(const Pose& pose, double timestamp, TrajectoryFormat format) {
   char buffer[512];
   int len = 0;
   if (format == TrajectoryFormat::kKitti) {
     const auto r = to_kitti_row(pose);
     len = std::snprintf(buffer, sizeof buffer,
-                        "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n",
+                        "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g",
                         r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8], r[9], r[10], r[11]);
   } else {
     const Eigen::Quaterniond q(pose.linear());
     const Eigen::Vector3d t = pose.translation();
-    len = std::snprintf(buffer, sizeof buffer, "%.9f %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n",
+    len = std::snprintf(buffer, sizeof buffer, "%.9f %.17g %.17g %.17g %.17g %.17g %.17g %.17g",
                         timestamp, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   }
   return std::string(buffer, static_cast<std::size_t>(len));
@@ -128,26 +126,20 @@ void write_trajectory(const std::string& path, const Trajectory& trajectory,
   if (trajectory.has_timestamps() && trajectory.timestamps.size() != trajectory.poses.size())
     fail(path, "cannot write: timestamps and poses differ in number");
   std::string text;
-  for (std::size_t i = 0; i < trajectory.size(); ++i)
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
     text += format_line(
         trajectory.poses[i],
         trajectory.has_timestamps() ? trajectory.timestamps[i] : static_cast<double>(i), format);
+    text += '\n';
+  }
   write_file_atomic(path, text);
 }
 
 TrajectoryWriter::TrajectoryWriter(const std::string& path, TrajectoryFormat format)
-    : path_(path), format_(format), file_(std::fopen(path.c_str(), "w")) {
-  if (!file_) fail(path, std::string("cannot create: ") + std::strerror(errno));
-}
-
-TrajectoryWriter::~TrajectoryWriter() {
-  if (file_) std::fclose(file_);
-}
+    : format_(format), file_(path) {}
 
 void TrajectoryWriter::write(const Pose& pose, double timestamp) {
-  const std::string line = format_line(pose, timestamp, format_);
-  if (std::fwrite(line.data(), 1, line.size(), file_) != line.size() || std::fflush(file_) != 0)
-    fail(path_, std::string("write failed: ") + std::strerror(errno));
+  file_.line(format_line(pose, timestamp, format_));
 }
 
 }  // namespace scanmatch

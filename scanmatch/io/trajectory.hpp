@@ -1,13 +1,13 @@
 #pragma once
 // Trajectories: KITTI poses (12 numbers a line, no timestamps) and TUM (t x y z qx qy qz qw).
 
-#include <cstdio>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "scanmatch/core/se3.hpp"
+#include "scanmatch/io/line_writer.hpp"
 
 namespace scanmatch {
 
@@ -43,15 +43,11 @@ void write_trajectory(const std::string& path, const Trajectory& trajectory,
 class TrajectoryWriter {
  public:
   TrajectoryWriter(const std::string& path, TrajectoryFormat format);
-  ~TrajectoryWriter();
-  TrajectoryWriter(const TrajectoryWriter&) = delete;
-  TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
   void write(const Pose& pose, double timestamp);
 
  private:
-  std::string path_;
   TrajectoryFormat format_;
-  std::FILE* file_ = nullptr;
+  LineWriter file_;
 };
 
 }  // namespace scanmatch

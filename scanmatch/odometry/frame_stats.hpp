@@ -1,17 +1,100 @@
 #pragma once
-// What one frame of odometry reports: stage times, point counts and the solver's diagnostics.
+// A frame's timing and diagnostics (Odometry::last_stats()) and the one description of them:
+// every field's key, the field and a help text. Everything that writes or reads the statistics
+// comes from describe(): timing.csv's columns and rows and its reader (below), the per-stage mean
+// and max of summary.json, and Python's Odometry.stats dictionaries. A new statistic is a member
+// of FrameStats and one line in describe().
+//
+// A visitor provides
+//   template <class T> void operator()(const char* key, T& field, const char* help);
+//   void stage(const char* key, double& ms, const char* stage, const char* help);
+// stage() is the time of a pipeline stage in ms: summary.json reports its mean and max under
+// "stages" as `stage`. A visitor of a const FrameStats gets const fields. for_each_field() visits
+// both kinds with one callable.
 
+#include <concepts>
 #include <cstddef>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 namespace scanmatch {
 
+/// One frame of the odometry; the meaning of each field is its help text in describe().
 struct FrameStats {
   double preprocess_ms = 0, coarse_ms = 0, fine_ms = 0, map_ms = 0, total_ms = 0;
   std::size_t points_in = 0, points_downsampled = 0;
-  int iterations = 0;             ///< coarse plus fine
-  double condition_number = 0;    ///< of the last stage's information matrix
-  int degenerate_directions = 0;  ///< directions the fine stage left at the motion prior
-  bool bridged = false;           ///< the frame could not be registered: the motion prior was used
+  int iterations = 0;
+  double condition_number = 0;
+  int degenerate_directions = 0;
+  bool bridged = false;
 };
+
+template <typename Stats, typename Visitor>
+requires std::same_as<std::remove_const_t<Stats>, FrameStats>
+void describe(Stats& s, Visitor& v) {
+  v.stage("preprocess_ms", s.preprocess_ms, "preprocess", "crops, voxel filter and deskew, ms");
+  v.stage("coarse_ms", s.coarse_ms, "coarse",
+          "ctf-icp's coarse NDT stage, or the frame-to-frame registration, ms");
+  v.stage("fine_ms", s.fine_ms, "fine", "ctf-icp's fine stage (frame to map), ms");
+  v.stage("map_ms", s.map_ms, "map_update", "ctf-icp's map update, ms");
+  v.stage("total_ms", s.total_ms, "total", "the whole frame (register_frame), ms");
+  v("points_in", s.points_in, "points of the frame as given");
+  v("points_downsampled", s.points_downsampled, "points left after the crops and voxel filter");
+  v("iterations", s.iterations, "registration iterations, coarse plus fine");
+  v("condition_number", s.condition_number, "of the last stage's information matrix");
+  v("degenerate_directions", s.degenerate_directions,
+    "directions the fine stage left at the motion prior");
+  v("bridged", s.bridged, "the frame could not be registered: the motion prior was used");
+}
+
+namespace frame_stats_detail {
+template <typename F>
+struct EveryField {
+  F& f;
+  template <typename T>
+  void operator()(const char* key, T& field, const char* help) {
+    f(key, field, help);
+  }
+  template <typename T>
+  void stage(const char* key, T& ms, const char*, const char* help) {
+    f(key, ms, help);
+  }
+};
+}  // namespace frame_stats_detail
+
+/// Calls f(key, field, help) for every field of `stats`, stage times included.
+template <typename Stats, typename F>
+void for_each_field(Stats& stats, F&& f) {
+  frame_stats_detail::EveryField<std::remove_reference_t<F>> visitor{f};
+  describe(stats, visitor);
+}
+
+// timing.csv: a header line "index,timestamp,<every key of describe()>", then a row a frame.
+// Stage times have 3 decimals, other numbers 6 significant digits, `bridged` is 0 or 1.
+
+std::string timing_csv_header();
+std::string timing_csv_row(std::size_t index, double timestamp, const FrameStats& stats);
+
+/// One row of timing.csv read back.
+struct FrameRecord {
+  std::size_t index = 0;
+  double timestamp = 0;
+  FrameStats stats;
+};
+
+/// Reads timing.csv by column name: columns it does not know (a newer file) are skipped, fields
+/// without a column (an older file) keep their defaults. Throws Error naming the file and line
+/// for a malformed value or a row whose length differs from the header's.
+std::vector<FrameRecord> read_timing_csv(const std::string& path);
+
+/// Mean and max of one stage time over a run (summary.json's "stages").
+struct StageStatistics {
+  std::string name;  ///< the stage's name in describe() ("map_update")
+  double mean_ms = 0.0, max_ms = 0.0;
+};
+
+/// Every stage of describe(), in its order (zeros for no frames).
+std::vector<StageStatistics> stage_statistics(const std::vector<FrameStats>& frames);
 
 }  // namespace scanmatch

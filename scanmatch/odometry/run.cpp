@@ -1,7 +1,5 @@
 #include "scanmatch/odometry/run.hpp"
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -14,36 +12,13 @@
 #include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
+#include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 
 namespace scanmatch {
 namespace {
-
-// Appended and flushed a line at a time, like the trajectory writers.
-class CsvWriter {
- public:
-  CsvWriter(const std::string& path, const std::string& header) : path_(path) {
-    file_ = std::fopen(path.c_str(), "w");
-    if (!file_) fail(path, "cannot open for writing");
-    line(header);
-  }
-  ~CsvWriter() {
-    if (file_) std::fclose(file_);
-  }
-  CsvWriter(const CsvWriter&) = delete;
-  CsvWriter& operator=(const CsvWriter&) = delete;
-  void line(const std::string& text) {
-    if (std::fputs(text.c_str(), file_) < 0 || std::fputc('\n', file_) == EOF ||
-        std::fflush(file_) != 0)
-      fail(path_, "write failed");
-  }
-
- private:
-  std::string path_;
-  std::FILE* file_ = nullptr;
-};
 
 // The exported map: one point per cell of `voxel` metres, first come first kept, optionally only
 // near the sensor. Bounded by the area the run covered, not by the number of frames.
@@ -79,19 +54,11 @@ class PointMap {
   std::vector<Point> points_;
 };
 
-StageStatistics statistics(const std::vector<FrameStats>& stats, double FrameStats::*field) {
-  StageStatistics s;
-  if (stats.empty()) return s;
-  for (const FrameStats& f : stats) {
-    s.mean_ms += f.*field;
-    s.max_ms = std::max(s.max_ms, f.*field);
-  }
-  s.mean_ms /= static_cast<double>(stats.size());
-  return s;
-}
-
-nlohmann::ordered_json stage_json(const StageStatistics& s) {
-  return {{"mean_ms", s.mean_ms}, {"max_ms", s.max_ms}};
+nlohmann::ordered_json stages_json(const std::vector<StageStatistics>& stages) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (const StageStatistics& s : stages)
+    j[s.name] = {{"mean_ms", s.mean_ms}, {"max_ms", s.max_ms}};
+  return j;
 }
 
 // The keys of `scanmatch eval --json`.
@@ -118,6 +85,12 @@ void write_ground_truth(const std::string& dir, const std::optional<Trajectory>&
 
 }  // namespace
 
+const StageStatistics& RunSummary::stage(std::string_view name) const {
+  for (const StageStatistics& s : stages)
+    if (s.name == name) return s;
+  throw std::out_of_range("no odometry stage '" + std::string(name) + "'");
+}
+
 RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                         const RunOptions& options) {
   const std::unique_ptr<FrameOdometry> odometry = make_frame_odometry(config);
@@ -131,7 +104,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     throw Error("map format must be pcd or ply (got '" + options.map_format + "')");
   if (!(options.map_voxel_size > 0.0)) throw Error("map export voxel size must be positive");
   std::unique_ptr<TrajectoryWriter> kitti, tum;
-  std::unique_ptr<CsvWriter> timing;
+  std::unique_ptr<LineWriter> timing;
   if (write) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
@@ -139,10 +112,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     write_file_atomic(dir + "/config.json", odometry_config_to_json(config));
     kitti = std::make_unique<TrajectoryWriter>(dir + "/poses.txt", TrajectoryFormat::kKitti);
     tum = std::make_unique<TrajectoryWriter>(dir + "/poses_tum.txt", TrajectoryFormat::kTum);
-    timing = std::make_unique<CsvWriter>(
-        dir + "/timing.csv",
-        "index,timestamp,preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,points_in,"
-        "points_downsampled,iterations,condition_number,degenerate_directions,bridged");
+    timing = std::make_unique<LineWriter>(dir + "/timing.csv");
+    timing->line(timing_csv_header());
   }
   const std::size_t total =
       options.max_frames > 0 ? std::min(options.max_frames, source.size()) : source.size();
@@ -177,11 +148,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     if (write) {
       kitti->write(pose, frame.timestamp);
       tum->write(pose, frame.timestamp);
-      timing->line(fmt::format("{},{:.6f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{},{},{},{:.6g},{},{}",
-                               summary.frames, frame.timestamp, s.preprocess_ms, s.coarse_ms,
-                               s.fine_ms, s.map_ms, s.total_ms, s.points_in, s.points_downsampled,
-                               s.iterations, s.condition_number, s.degenerate_directions,
-                               s.bridged ? 1 : 0));
+      timing->line(timing_csv_row(summary.frames, frame.timestamp, s));
     }
     // A bridged frame has no registered points of its own (an empty frame leaves the previous
     // one in last_frame()); it would only add a copy or a guess to the map.
@@ -197,11 +164,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     progress.update(summary.frames);
   }
   progress.finish();
-  summary.preprocess = statistics(summary.stats, &FrameStats::preprocess_ms);
-  summary.coarse = statistics(summary.stats, &FrameStats::coarse_ms);
-  summary.fine = statistics(summary.stats, &FrameStats::fine_ms);
-  summary.map_update = statistics(summary.stats, &FrameStats::map_ms);
-  summary.total = statistics(summary.stats, &FrameStats::total_ms);
+  summary.stages = stage_statistics(summary.stats);
   summary.frames_per_second = pipeline_ms > 0.0 ? 1000.0 * summary.frames / pipeline_ms : 0.0;
   evaluate(truth, summary);
 
@@ -220,12 +183,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                 {"error", summary.error},
                                 {"frames_per_second", summary.frames_per_second},
                                 {"threads", config.threads},
-                                {"stages",
-                                 {{"preprocess", stage_json(summary.preprocess)},
-                                  {"coarse", stage_json(summary.coarse)},
-                                  {"fine", stage_json(summary.fine)},
-                                  {"map_update", stage_json(summary.map_update)},
-                                  {"total", stage_json(summary.total)}}}};
+                                {"stages", stages_json(summary.stages)}};
     if (summary.ate) j["ate"] = ate_json(*summary.ate);
     j["options"] = nlohmann::ordered_json::parse(odometry_config_to_json(config));
     write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");

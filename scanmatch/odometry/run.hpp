@@ -4,13 +4,14 @@
 //   poses_tum.txt   the same poses as TUM rows (timestamp tx ty tz qx qy qz qw)
 //   poses_gt.txt    when the source has ground truth: its poses for the frames run (KITTI rows),
 //   poses_gt_tum.txt  and as TUM rows when it has timestamps (written at the end)
-//   timing.csv      per frame: index,timestamp,preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,
+//   timing.csv      per frame: index,timestamp, then the FrameStats fields in the order of their
+//                   description (frame_stats.hpp): preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,
 //                   points_in,points_downsampled,iterations,condition_number,
 //                   degenerate_directions,bridged
-//   summary.json    method, options (the whole configuration), frames, mean and max ms per stage,
-//                   frames per second, whether the run was interrupted, the error that ended it
-//                   early, and the ATE when the source has ground truth (written atomically
-//                   at the end, also after such an error)
+//   summary.json    method, options (the whole configuration), frames, mean and max ms of each
+//                   stage of frame_stats.hpp, frames per second, whether the run was interrupted,
+//                   the error that ended it early, and the ATE when the source has ground truth
+//                   (written atomically at the end, also after such an error)
 //   config.json     the OdometryConfig used (reloadable with --config)
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
 // Per-frame files are appended and flushed frame by frame, so an interrupted run keeps its frames.
@@ -20,6 +21,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scanmatch/eval/metrics.hpp"
@@ -41,26 +43,26 @@ struct RunOptions {
   const std::atomic<bool>* stop = nullptr;
 };
 
-struct StageStatistics {
-  double mean_ms = 0.0, max_ms = 0.0;
-};
-
 struct RunSummary {
   std::string method;
   std::string source;  ///< SequenceSource::describe()
   std::size_t frames = 0, bridged_frames = 0;
   bool interrupted = false;
   std::string error;  ///< why the source could not deliver a frame (empty: it did not fail)
-  StageStatistics preprocess, coarse, fine, map_update, total;
-  double frames_per_second = 0.0;  ///< 1000 / mean total ms (pipeline time only)
-  std::vector<double> timestamps;  ///< per frame
-  std::vector<Pose> poses;         ///< per frame, world frame of frame 0
-  std::vector<FrameStats> stats;   ///< per frame
+  /// Every stage of frame_stats.hpp, in its order (zeros before a run).
+  std::vector<StageStatistics> stages = stage_statistics({});
+  double frames_per_second = 0.0;       ///< 1000 / mean total ms (pipeline time only)
+  std::vector<double> timestamps;       ///< per frame
+  std::vector<Pose> poses;              ///< per frame, world frame of frame 0
+  std::vector<FrameStats> stats;        ///< per frame
   /// The source's ground truth for the frames run (empty when it has none), as in poses_gt.txt.
   std::vector<Pose> ground_truth;
   /// ATE of `poses` against `ground_truth`, unaligned (both start at the identity, as the run
   /// does); absent without ground truth or frames.
   std::optional<AteResult> ate;
+
+  /// The stage named `name` in frame_stats.hpp ("total"); throws std::out_of_range for others.
+  const StageStatistics& stage(std::string_view name) const;
 };
 
 /// Runs `config` over `source` (from its current position) and writes RUNDIR as described above.

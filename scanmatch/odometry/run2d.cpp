@@ -9,6 +9,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/io/file_util.hpp"
+#include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/sim/simulator.hpp"
@@ -79,10 +80,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   Mapper2D mapper(options.mapper);
   OccupancyGrid grid(options.grid), reference_grid(options.grid);
   TrajectoryWriter poses(file("poses_tum.txt"), TrajectoryFormat::kTum);
-  std::FILE* timing = std::fopen(file("timing.csv").c_str(), "w");
-  if (!timing) throw Error(file("timing.csv") + ": cannot open for writing");
-  std::fprintf(timing, "scan,ms,iterations,points,pairs,error_m,bridged\n");
-  std::fflush(timing);
+  LineWriter timing(file("timing.csv"));
+  timing.line("scan,ms,iterations,points,pairs,error_m,bridged");
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
@@ -106,9 +105,10 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     estimate.push_back(pose);
     reference.push_back(pose2(laser.pose));
     poses.write(to_pose3(pose), laser.timestamp);
-    std::fprintf(timing, "%zu,%.4f,%d,%zu,%zu,%.6f,%d\n", i, s.ms, s.iterations, s.points, s.pairs,
-                 s.error, s.bridged ? 1 : 0);
-    std::fflush(timing);
+    char row[512];
+    std::snprintf(row, sizeof row, "%zu,%.4f,%d,%zu,%zu,%.6f,%d", i, s.ms, s.iterations, s.points,
+                  s.pairs, s.error, s.bridged ? 1 : 0);
+    timing.line(row);
     // A trajectory that ran away (a failed method on hard data) can need more cells than the
     // grid allows: the run goes on and keeps its poses, without that map.
     const auto insert = [&](OccupancyGrid& g, std::string& error, const Pose2& at) {
@@ -131,7 +131,6 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     progress.update(i + 1);
   }
   progress.finish();
-  std::fclose(timing);
   summary.scans = estimate.size();
   if (summary.scans > 1) {
     summary.mean_ms = total_ms / static_cast<double>(summary.scans - 1);

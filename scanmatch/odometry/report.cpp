@@ -1,4 +1,4 @@
-#include "scanmatch/eval/report.hpp"
+#include "scanmatch/odometry/report.hpp"
 
 #include <fmt/format.h>
 
@@ -48,8 +48,9 @@ std::string render_report(const std::vector<RunFolder>& runs,
     const std::optional<Trajectory>& gt = ground_truth ? ground_truth : run.ground_truth;
     double mean_ms = 0;
     std::size_t bridged = 0;
-    for (const auto& t : run.timing) mean_ms += t.total_ms / static_cast<double>(run.timing.size());
-    for (const auto& t : run.timing) bridged += t.bridged;
+    for (const auto& t : run.timing)
+      mean_ms += t.stats.total_ms / static_cast<double>(run.timing.size());
+    for (const auto& t : run.timing) bridged += t.stats.bridged;
     std::string accuracy = "<td>-</td><td>-</td><td>-</td><td>-</td><td>-</td>";
     if (gt) {
       const Association pairs = associate(*gt, run.poses, /*allow_partial=*/true);
@@ -98,7 +99,7 @@ std::string render_report(const std::vector<RunFolder>& runs,
         make_series("fine", palette_color(0)), make_series("map update", palette_color(4)),
         make_series("total", "#000000")};
     for (std::size_t k = 0; k < run.timing.size(); ++k) {
-      const FrameTiming& t = run.timing[k];
+      const FrameStats& t = run.timing[k].stats;
       const double x = static_cast<double>(k);
       stages[0].points.emplace_back(x, t.preprocess_ms);
       stages[1].points.emplace_back(x, t.coarse_ms);

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "scanmatch/eval/run_folder.hpp"
+#include "scanmatch/odometry/run_folder.hpp"
 
 namespace scanmatch {
 

@@ -1,29 +1,23 @@
 #pragma once
-// Reading a run folder written by `scanmatch odometry` (scanmatch/odometry/run.hpp documents the
-// files): the poses, the per-frame timing, the summary and the ground truth written beside them.
+// Reading a run folder written by `scanmatch odometry` (run.hpp documents the files): the poses,
+// the per-frame statistics (timing.csv), the summary and the ground truth written beside them.
 
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/odometry/frame_stats.hpp"
 
 namespace scanmatch {
 
-struct FrameTiming {
-  double timestamp = 0, preprocess_ms = 0, coarse_ms = 0, fine_ms = 0, map_ms = 0, total_ms = 0;
-  double condition_number = 0;
-  int iterations = 0, degenerate_directions = 0;
-  bool bridged = false;
-};
-
 struct RunFolder {
   std::string path;
-  std::string method;                      ///< from summary.json ("?" when absent)
+  std::string method = "?";                ///< from summary.json ("?" when absent)
   std::string label;                       ///< the folder's name
   Trajectory poses;                        ///< poses.txt (or poses_tum.txt)
   std::optional<Trajectory> ground_truth;  ///< poses_gt.txt when present
-  std::vector<FrameTiming> timing;         ///< timing.csv, empty when absent
+  std::vector<FrameRecord> timing;         ///< timing.csv, empty when absent
   double frames_per_second = 0;            ///< from summary.json
   bool interrupted = false;
   bool has_map = false;  ///< map.pcd present

@@ -1,0 +1,44 @@
+#include "scanmatch/odometry/run_folder.hpp"
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/io/file_util.hpp"
+
+namespace scanmatch {
+
+RunFolder read_run_folder(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(path)) fail(path, "not a run folder (no such directory)");
+  RunFolder run;
+  run.path = path;
+  run.label = fs::path(path).lexically_normal().filename().string();
+  if (run.label.empty()) run.label = fs::path(path).lexically_normal().parent_path().filename();
+  const std::string poses = path + "/poses.txt", tum = path + "/poses_tum.txt";
+  if (fs::exists(tum))
+    run.poses = read_trajectory(tum);
+  else if (fs::exists(poses))
+    run.poses = read_trajectory(poses);
+  else
+    fail(path, "no poses.txt or poses_tum.txt: not a run folder of scanmatch odometry");
+  if (fs::exists(path + "/poses_gt_tum.txt"))
+    run.ground_truth = read_trajectory(path + "/poses_gt_tum.txt");
+  else if (fs::exists(path + "/poses_gt.txt"))
+    run.ground_truth = read_trajectory(path + "/poses_gt.txt");
+  if (fs::exists(path + "/timing.csv")) run.timing = read_timing_csv(path + "/timing.csv");
+  if (fs::exists(path + "/summary.json")) {
+    try {
+      const auto j = nlohmann::json::parse(read_file_bytes(path + "/summary.json"));
+      run.method = j.value("method", std::string("?"));
+      run.frames_per_second = j.value("frames_per_second", 0.0);
+      run.interrupted = j.value("interrupted", false);
+    } catch (const nlohmann::json::exception& e) {
+      fail(path + "/summary.json", std::string("malformed: ") + e.what());
+    }
+  }
+  run.has_map = fs::exists(path + "/map.pcd");
+  return run;
+}
+
+}  // namespace scanmatch
