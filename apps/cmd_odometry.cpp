@@ -9,17 +9,16 @@
 #include "apps/config_options.hpp"
 #include "apps/interrupt.hpp"
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/run.hpp"
-#include "scanmatch/sim/simulator.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch::cli {
 namespace {
 
 struct OdometryCommand {
-  std::string sequence, out, config_file, topic;
+  std::string sequence, out, config_file, topic, reference;
   std::size_t frames = 0;
   std::uint64_t seed = 1;
   bool quiet = false, no_fine = false, no_map_update = false, no_deskew = false;
@@ -38,14 +37,12 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
   if (c.no_deskew) config.deskew = false;
   config.registration.solver.num_threads = config.threads;
 
-  sim::SimOptions sim_options;
-  sim_options.seed = c.seed;
-  if (c.frames > 0) sim_options.frames = c.frames;
-  const bool simulated = c.sequence.rfind("sim:", 0) == 0;
-  if (!simulated && !std::filesystem::exists(c.sequence))
-    throw Error(c.sequence + ": no such sequence (a folder, a KITTI sequence or sim:PRESET)");
-  const auto source = is_bag_path(c.sequence) ? open_bag_sequence(c.sequence, c.topic)
-                                              : sim::open_sequence(c.sequence, sim_options);
+  SequenceOptions input;
+  input.topic = c.topic;
+  input.reference = c.reference;
+  input.simulator.seed = c.seed;
+  if (c.frames > 0) input.simulator.frames = c.frames;
+  const auto source = open_sequence(c.sequence, input);
   c.run.out_dir = c.out;
   c.run.max_frames = c.frames;
   c.run.quiet = c.quiet;
@@ -97,6 +94,9 @@ void add_odometry_command(CLI::App& app) {
                   "JSON configuration (as written to RUNDIR/config.json); options given here win");
   cmd->add_option("--frames", c->frames, "Process at most this many frames (0: all)");
   cmd->add_option("--seed", c->seed, "Seed of sim:PRESET sequences")->capture_default_str();
+  cmd->add_option("--reference", c->reference,
+                  "Ground truth for the ATE from this trajectory file (KITTI or TUM, one pose per "
+                  "frame) instead of the sequence's own");
   add_config_options(cmd, o);
   cmd->get_option("--method")->description("One of: " + odometry_methods_with_peers());
   cmd->add_flag("--no-fine", c->no_fine, "Ablation: coarse NDT stage only");

@@ -9,7 +9,7 @@
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/run.hpp"
-#include "scanmatch/sim/simulator.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
@@ -38,9 +38,9 @@ class FramesOnly : public SequenceSource {
 
 TEST(OdometryRun, WritesTheGroundTruthOfTheFramesRunAndItsAte) {
   TempDir dir;
-  sim::SimOptions sim;
-  sim.frames = 8;
-  const auto source = sim::open_sequence("sim:dynamic-outdoor-fast", sim);
+  SequenceOptions input;
+  input.simulator.frames = 8;
+  const auto source = open_sequence("sim:dynamic-outdoor-fast", input);
   RunOptions options;
   options.out_dir = dir.file("run");
   options.max_frames = 6;  // fewer than the source has: the ground truth follows the run
@@ -73,9 +73,9 @@ TEST(OdometryRun, WritesTheGroundTruthOfTheFramesRunAndItsAte) {
 
 TEST(OdometryRun, WithoutGroundTruthThereIsNoneBesideThePoses) {
   TempDir dir;
-  sim::SimOptions sim;
-  sim.frames = 3;
-  FramesOnly source(sim::open_sequence("sim:static-indoor", sim));
+  SequenceOptions input;
+  input.simulator.frames = 3;
+  FramesOnly source(open_sequence("sim:static-indoor", input));
   RunOptions options;
   options.out_dir = dir.file("run");
   options.quiet = true;
