@@ -85,7 +85,7 @@ TEST(OpenSequence, AReferenceFileIsTheGroundTruthAnchoredAtTheFirstFrame) {
   options.reference = dir.file("odom.txt");
   const auto source = open_sequence(dir.file("set"), options);
   ASSERT_TRUE(source->ground_truth());
-  const Trajectory& gt = *source->ground_truth();
+  const Trajectory gt = *source->ground_truth();  // returned by value
   ASSERT_EQ(gt.size(), 3u);
   EXPECT_TRUE(gt.poses[0].isApprox(Pose::Identity(), 1e-12));
   EXPECT_NEAR(gt.poses[2].translation().x(), 3.0, 1e-12);
