@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <functional>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/cloud_io.hpp"
@@ -15,17 +14,9 @@
 namespace scanmatch {
 namespace {
 
+using testing::error_of;
 using testing::TempDir;
 using testing::write_text;
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // Three frames of two points each in DIR/frames/, with times.txt beside them.
 void write_frames(const TempDir& dir) {
