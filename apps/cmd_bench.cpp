@@ -16,7 +16,11 @@ void add_bench_command(CLI::App& app) {
       "bench", "Every method on every sequence in one run: the papers' tables and a report");
   cmd->add_option("--preset", o->presets,
                   "Simulator presets (default: the CTF-ICP paper's five data sets)");
-  cmd->add_option("--sequence", o->sequences, "Sequence folders (with ground truth) to add");
+  cmd->add_option("--sequence", o->sequences,
+                  "Sequences to add (folders, KITTI sequences, bags; with ground truth for ATE)");
+  cmd->add_option("--reference", o->references,
+                  "Ground truth of each --sequence from a trajectory file (KITTI or TUM), one per "
+                  "--sequence, in order");
   cmd->add_option("--method,--methods", o->methods,
                   "Methods (default: ctf-icp icp ndt gicp vgicp loam point-to-plane "
                   "point-to-line; any of " +
@@ -32,6 +36,7 @@ void add_bench_command(CLI::App& app) {
     options.command_line = "scanmatch bench";
     for (const auto& p : o->presets) options.command_line += " --preset " + p;
     for (const auto& s : o->sequences) options.command_line += " --sequence " + s;
+    for (const auto& r : o->references) options.command_line += " --reference " + r;
     for (const auto& m : o->methods) options.command_line += " --method " + m;
     if (o->frames > 0) options.command_line += " --frames " + std::to_string(o->frames);
     options.command_line += " --threads " + std::to_string(o->threads);

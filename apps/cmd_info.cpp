@@ -14,8 +14,8 @@
 #include "scanmatch/io/bag/bag.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
-#include "scanmatch/io/sequence.hpp"
 #include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch::cli {
 namespace {
@@ -82,7 +82,7 @@ nlohmann::ordered_json carmen_info(const std::string& path) {
 }
 
 nlohmann::ordered_json sequence_info(const std::string& path) {
-  const auto sequence = open_sequence_folder(path);
+  const auto sequence = open_sequence(path);
   nlohmann::ordered_json j = {{"kind", "sequence"},
                               {"description", sequence->describe()},
                               {"frames", sequence->size()},

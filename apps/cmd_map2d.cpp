@@ -7,7 +7,6 @@
 #include "apps/config_options.hpp"
 #include "apps/interrupt.hpp"
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/run2d.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
@@ -84,14 +83,11 @@ void add_map2d_command(CLI::App& app) {
   cmd->add_flag("--quiet", c->run.quiet, "No progress and no summary lines");
   cmd->callback([c, cmd] {
     Map2DRunOptions run = configuration(*c, *cmd);
-    Scans2D input;
-    if (is_bag_path(c->sequence)) {
-      input.scans = read_bag_laser_scans(c->sequence, c->topic, c->scans);
-      if (input.scans.empty()) throw Error(c->sequence + ": the topic holds no laser scans");
-      input.description = c->sequence;
-    } else {
-      input = load_scans_2d(c->sequence, c->scans, c->seed, !c->no_motion_distortion);
-    }
+    SequenceOptions input_options;
+    input_options.topic = c->topic;
+    input_options.simulator.seed = c->seed;
+    input_options.simulator.motion_distortion = !c->no_motion_distortion;
+    Scans2D input = load_scans_2d(c->sequence, input_options, c->scans);
     if (c->rotation_period >= 0.0) input.rotation_period = c->rotation_period;
     Map2DSummary s;
     {

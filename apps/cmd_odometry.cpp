@@ -3,57 +3,49 @@
 
 #include <fmt/format.h>
 
-#include <filesystem>
-
 #include "apps/commands.hpp"
 #include "apps/config_options.hpp"
 #include "apps/interrupt.hpp"
-#include "scanmatch/core/error.hpp"
-#include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/run.hpp"
-#include "scanmatch/sim/simulator.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch::cli {
 namespace {
 
 struct OdometryCommand {
-  std::string sequence, out, config_file, topic;
+  std::string sequence, out, config_file, topic, reference;
   std::size_t frames = 0;
   std::uint64_t seed = 1;
-  bool quiet = false, no_fine = false, no_map_update = false, no_deskew = false;
-  RunOptions run;
-  OdometryConfig config;
+  bool quiet = false;
+  OdometryRunConfig config;  ///< the flags of the one description, for config.json
 };
 
 void run_command(OdometryCommand& c, const CLI::App& cmd) {
   // Options given on the command line win over the --config file.
-  OdometryConfig config = c.config;
+  OdometryRunConfig given = c.config;
   if (!c.config_file.empty())
-    config = override_given_flags(read_odometry_config(c.config_file), c.config,
-                                  [&](const std::string& flag) { return cmd.count(flag) > 0; });
-  if (c.no_fine) config.fine_stage = false;
-  if (c.no_map_update) config.map_update = false;
-  if (c.no_deskew) config.deskew = false;
+    given = override_given_flags(read_odometry_run_config(c.config_file), c.config,
+                                 [&](const std::string& flag) { return cmd.count(flag) > 0; });
+  OdometryConfig& config = given.odometry;
   config.registration.solver.num_threads = config.threads;
 
-  sim::SimOptions sim_options;
-  sim_options.seed = c.seed;
-  if (c.frames > 0) sim_options.frames = c.frames;
-  const bool simulated = c.sequence.rfind("sim:", 0) == 0;
-  if (!simulated && !std::filesystem::exists(c.sequence))
-    throw Error(c.sequence + ": no such sequence (a folder, a KITTI sequence or sim:PRESET)");
-  const auto source = is_bag_path(c.sequence) ? open_bag_sequence(c.sequence, c.topic)
-                                              : sim::open_sequence(c.sequence, sim_options);
-  c.run.out_dir = c.out;
-  c.run.max_frames = c.frames;
-  c.run.quiet = c.quiet;
+  SequenceOptions input;
+  input.topic = c.topic;
+  input.reference = c.reference;
+  input.simulator.seed = c.seed;
+  if (c.frames > 0) input.simulator.frames = c.frames;
+  const auto source = open_sequence(c.sequence, input);
+  RunOptions run = given.output;
+  run.out_dir = c.out;
+  run.max_frames = c.frames;
+  run.quiet = c.quiet;
   RunSummary summary;
   {
     const InterruptFlag interrupt;
-    c.run.stop = interrupt.flag();
-    summary = run_odometry(*source, config, c.run);
+    run.stop = interrupt.flag();
+    summary = run_odometry(*source, config, run);
   }
   std::string accuracy;
   if (const auto& ate = summary.ate)
@@ -84,7 +76,6 @@ void add_odometry_command(CLI::App& app) {
   auto c = std::make_shared<OdometryCommand>();
   auto* cmd = app.add_subcommand(
       "odometry", "LiDAR odometry over a sequence: poses, timing, summary and optionally a map");
-  OdometryConfig& o = c->config;
   cmd->add_option("SEQUENCE", c->sequence,
                   "A folder of PCD/PLY/BIN frames, a KITTI sequence, a simulated data set, "
                   "sim:PRESET or a ROS bag (.bag, .db3, .mcap)")
@@ -97,18 +88,11 @@ void add_odometry_command(CLI::App& app) {
                   "JSON configuration (as written to RUNDIR/config.json); options given here win");
   cmd->add_option("--frames", c->frames, "Process at most this many frames (0: all)");
   cmd->add_option("--seed", c->seed, "Seed of sim:PRESET sequences")->capture_default_str();
-  add_config_options(cmd, o);
+  cmd->add_option("--reference", c->reference,
+                  "Ground truth for the ATE from this trajectory file (KITTI or TUM, one pose per "
+                  "frame) instead of the sequence's own");
+  add_config_options(cmd, c->config);
   cmd->get_option("--method")->description("One of: " + odometry_methods_with_peers());
-  cmd->add_flag("--no-fine", c->no_fine, "Ablation: coarse NDT stage only");
-  cmd->add_flag("--no-map-update", c->no_map_update,
-                "Ablation: fine stage against the previous frame, no global map");
-  cmd->add_flag("--no-deskew", c->no_deskew, "Do not correct motion distortion");
-  cmd->add_flag("--save-map", c->run.write_map, "Write RUNDIR/map.pcd (or .ply)");
-  cmd->add_option("--map-format", c->run.map_format, "pcd or ply")->capture_default_str();
-  cmd->add_option("--map-export-voxel", c->run.map_voxel_size, "Exported map voxel, m")
-      ->capture_default_str();
-  cmd->add_option("--map-export-radius", c->run.map_export_radius,
-                  "Export only points within this radius of the last pose, m (0: all)");
   cmd->add_flag("--quiet", c->quiet, "No progress and no summary lines");
   cmd->callback([c, cmd] { run_command(*c, *cmd); });
 }

@@ -22,9 +22,8 @@ struct RegisterCommand {
   std::string source, target, init;
   bool planar = false;
   Registration2DOptions planar_options;
-  double voxel = 0.1;
   bool json = false;
-  RegistrationOptions options;
+  PairRegistrationOptions pair;
   const CLI::Option *method = nullptr, *max_distance = nullptr;  ///< given: they apply to --2d
 };
 
@@ -110,9 +109,10 @@ void run_2d(RegisterCommand& c) {
 
 void run(RegisterCommand& c) {
   if (c.planar) {
-    if (c.method->count() > 0) c.planar_options.method = c.options.method;
+    if (c.method->count() > 0) c.planar_options.method = c.pair.registration.method;
     if (c.max_distance->count() > 0)
-      c.planar_options.max_correspondence_distance = c.options.max_correspondence_distance;
+      c.planar_options.max_correspondence_distance =
+          c.pair.registration.max_correspondence_distance;
     check_registration_2d_method(c.planar_options.method);
     return run_2d(c);
   }
@@ -120,21 +120,21 @@ void run(RegisterCommand& c) {
   PointCloud source = read_cloud(c.source), target = read_cloud(c.target);
   if (source.empty()) throw Error(c.source + ": the cloud is empty");
   if (target.empty()) throw Error(c.target + ": the cloud is empty");
-  if (c.voxel > 0.0) {
-    source = voxel_downsample(source, c.voxel);
-    target = voxel_downsample(target, c.voxel);
+  if (c.pair.voxel_size > 0.0) {
+    source = voxel_downsample(source, c.pair.voxel_size);
+    target = voxel_downsample(target, c.pair.voxel_size);
   }
   const auto start = std::chrono::steady_clock::now();
-  const RegistrationResult r = register_clouds(source, target, c.options, initial);
+  const RegistrationResult r = register_clouds(source, target, c.pair.registration, initial);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::size_t matched = 0;
-  const double fitness =
-      fitness_score(source, target, r.transform, c.options.max_correspondence_distance, &matched);
+  const double fitness = fitness_score(source, target, r.transform,
+                                       c.pair.registration.max_correspondence_distance, &matched);
   const Eigen::Matrix4d M = to_matrix(r.transform);
   if (c.json) {
     nlohmann::ordered_json j;
-    j["method"] = c.options.method;
+    j["method"] = c.pair.registration.method;
     j["transform"] = std::vector<std::vector<double>>{{M(0, 0), M(0, 1), M(0, 2), M(0, 3)},
                                                       {M(1, 0), M(1, 1), M(1, 2), M(1, 3)},
                                                       {M(2, 0), M(2, 1), M(2, 2), M(2, 3)},
@@ -154,7 +154,7 @@ void run(RegisterCommand& c) {
   for (int i = 0; i < 4; ++i)
     fmt::print("{:12.8f} {:12.8f} {:12.8f} {:12.8f}\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
   fmt::print(
-      "method {}: {} iterations, {}, {:.1f} ms\n", c.options.method, r.iterations,
+      "method {}: {} iterations, {}, {:.1f} ms\n", c.pair.registration.method, r.iterations,
       r.converged ? "converged (" + r.stop_reason + ")" : "not converged (" + r.stop_reason + ")",
       ms);
   fmt::print("fitness {:.6g} m^2 over {} of {} points; condition number {:.4g}\n", fitness, matched,
@@ -170,16 +170,14 @@ void add_register_command(CLI::App& app) {
       "Register SOURCE onto TARGET; prints the 4x4 transform mapping SOURCE into TARGET");
   cmd->add_option("SOURCE", c->source, "Source cloud")->required();
   cmd->add_option("TARGET", c->target, "Target cloud")->required();
-  c->method =
-      cmd->add_option("--method", c->options.method, "One of: " + registration_method_list())
-          ->capture_default_str();
+  c->method = cmd->add_option("--method", c->pair.registration.method,
+                              "One of: " + registration_method_list())
+                  ->capture_default_str();
   cmd->add_option("--init", c->init,
                   "Initial guess: 16 numbers (row-major 4x4) or x,y,z,roll,pitch,yaw (m, deg)");
-  cmd->add_option("--voxel", c->voxel, "Voxel downsampling of both clouds, m (0: none)")
+  cmd->add_option("--threads", c->pair.registration.solver.num_threads, "Threads for linearisation")
       ->capture_default_str();
-  cmd->add_option("--threads", c->options.solver.num_threads, "Threads for linearisation")
-      ->capture_default_str();
-  add_config_options(cmd, c->options);
+  add_config_options(cmd, c->pair);
   c->max_distance = cmd->get_option("--max-distance");
   cmd->add_flag("--json", c->json, "Print JSON");
   cmd->add_flag("--2d", c->planar,

@@ -1,8 +1,10 @@
 #pragma once
 // Command-line options from the configuration's one description (odometry/config_fields.hpp):
-// every described field with a flag becomes an option bound to that field.
+// every described field with a flag becomes an option bound to that field (a bool's "--no-" flag
+// sets it to false).
 
 #include <CLI/CLI.hpp>
+#include <string_view>
 #include <type_traits>
 
 #include "scanmatch/odometry/config_fields.hpp"
@@ -15,7 +17,11 @@ struct ConfigOptionAdder {
   void operator()(const char*, T& field, const char* flag, const char* help) {
     if (!flag) return;
     if constexpr (std::is_same_v<T, bool>) {
-      cmd->add_flag(flag, field, help);
+      if (std::string_view(flag).starts_with("--no-"))
+        cmd->add_flag_callback(
+            flag, [&field] { field = false; }, help);
+      else
+        cmd->add_flag(flag, field, help);
     } else if constexpr (std::is_enum_v<T>) {
       cmd->add_option_function<std::string>(
              flag, [&field](const std::string& name) { enum_from_name(name, field); }, help)

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
 
 #include "scanmatch/core/error.hpp"
@@ -47,6 +48,103 @@ TEST(ConfigDescription, FlagsAreUniqueAndSpelledLikeOptions) {
   }
   EXPECT_TRUE(seen.count("--max-iterations"));
   EXPECT_TRUE(seen.count("--voxel-resolution"));
+}
+
+// Every option of `odometry` and `register` that shapes a result is described, so config.json
+// (odometry) and the Python keywords see it.
+TEST(ConfigDescription, RunAndRegisterOptionsAreDescribedOnce) {
+  const auto run = flags_of<OdometryRunConfig>();
+  const std::set<std::string> run_flags(run.begin(), run.end());
+  EXPECT_EQ(run_flags.size(), run.size());
+  for (const char* flag : {"--no-fine", "--no-map-update", "--no-deskew", "--save-map",
+                           "--map-format", "--map-export-voxel", "--map-export-radius"})
+    EXPECT_TRUE(run_flags.count(flag)) << flag;
+  const auto pair = flags_of<PairRegistrationOptions>();
+  const std::set<std::string> pair_flags(pair.begin(), pair.end());
+  EXPECT_EQ(pair_flags.size(), pair.size());
+  EXPECT_TRUE(pair_flags.count("--voxel"));
+  EXPECT_TRUE(pair_flags.count("--max-iterations"));
+}
+
+TEST(ConfigDescription, RunOptionsAndAblationsRoundTripThroughConfigJson) {
+  testing::TempDir dir;
+  OdometryRunConfig changed;
+  changed.odometry.fine_stage = false;
+  changed.odometry.map_update = false;
+  changed.odometry.deskew = false;
+  changed.output.write_map = true;
+  changed.output.map_format = "ply";
+  changed.output.map_voxel_size = 0.35;
+  changed.output.map_export_radius = 42.0;
+  changed.output.out_dir = "not/configuration";  // per invocation: not written
+  const std::string text = odometry_run_config_to_json(changed);
+  EXPECT_EQ(text.find("not/configuration"), std::string::npos) << text;
+  testing::write_text(dir.file("config.json"), text);
+
+  const OdometryRunConfig back = read_odometry_run_config(dir.file("config.json"));
+  EXPECT_FALSE(back.odometry.fine_stage);
+  EXPECT_FALSE(back.odometry.map_update);
+  EXPECT_FALSE(back.odometry.deskew);
+  EXPECT_TRUE(back.output.write_map);
+  EXPECT_EQ(back.output.map_format, "ply");
+  EXPECT_DOUBLE_EQ(back.output.map_voxel_size, 0.35);
+  EXPECT_DOUBLE_EQ(back.output.map_export_radius, 42.0);
+  EXPECT_TRUE(back.output.out_dir.empty());
+  EXPECT_EQ(odometry_run_config_to_json(back), text);
+  // The pipeline's part alone reads the same file.
+  EXPECT_FALSE(read_odometry_config(dir.file("config.json")).fine_stage);
+
+  // A config.json written before "map_export" existed keeps the base's map options.
+  testing::write_text(dir.file("old.json"), R"({"method": "ndt", "fine_stage": false})");
+  const OdometryRunConfig old = read_odometry_run_config(dir.file("old.json"), changed);
+  EXPECT_EQ(old.odometry.method, "ndt");
+  EXPECT_EQ(old.output.map_format, "ply");
+  EXPECT_DOUBLE_EQ(old.output.map_voxel_size, 0.35);
+  const OdometryRunConfig plain = read_odometry_run_config(dir.file("old.json"));
+  EXPECT_FALSE(plain.output.write_map);
+  EXPECT_EQ(plain.output.map_format, "pcd");
+
+  testing::write_text(dir.file("bad.json"), R"({"map_export": {"fromat": "ply"}})");
+  try {
+    read_odometry_run_config(dir.file("bad.json"));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("map_export.fromat"), std::string::npos) << e.what();
+  }
+}
+
+// A run's config.json repeats its ablation and map export switches when given to --config; a
+// switch given beside --config still wins.
+TEST(ConfigDescription, OdometryRunsRepeatTheirSwitchesFromConfigJson) {
+  testing::TempDir dir;
+  const std::string common = "odometry sim:static-indoor --frames 3 --threads 1 --quiet ";
+  const auto first =
+      testing::run_cli(common + "--no-fine --save-map --map-format ply --out " + dir.file("first"));
+  ASSERT_EQ(first.status, 0) << first.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("first/map.ply")));
+  const OdometryRunConfig written = read_odometry_run_config(dir.file("first/config.json"));
+  EXPECT_FALSE(written.odometry.fine_stage);
+  EXPECT_TRUE(written.odometry.map_update);
+  EXPECT_TRUE(written.output.write_map);
+  EXPECT_EQ(written.output.map_format, "ply");
+
+  const auto again = testing::run_cli(common + "--config " + dir.file("first/config.json") +
+                                      " --out " + dir.file("again"));
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(read_file_bytes(dir.file("again/config.json")),
+            read_file_bytes(dir.file("first/config.json")));
+  EXPECT_TRUE(std::filesystem::exists(dir.file("again/map.ply")));
+  EXPECT_EQ(read_file_bytes(dir.file("again/poses.txt")),
+            read_file_bytes(dir.file("first/poses.txt")));
+
+  const auto more = testing::run_cli(common + "--config " + dir.file("first/config.json") +
+                                     " --no-deskew --map-format pcd --out " + dir.file("more"));
+  ASSERT_EQ(more.status, 0) << more.output;
+  const OdometryRunConfig overridden = read_odometry_run_config(dir.file("more/config.json"));
+  EXPECT_FALSE(overridden.odometry.fine_stage);  // from the file
+  EXPECT_FALSE(overridden.odometry.deskew);      // given
+  EXPECT_EQ(overridden.output.map_format, "pcd");
+  EXPECT_TRUE(std::filesystem::exists(dir.file("more/map.pcd")));
 }
 
 TEST(ConfigDescription, EveryFieldRoundTripsThroughJson) {

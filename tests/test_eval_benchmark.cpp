@@ -131,6 +131,33 @@ TEST(Benchmark, ATinyRunWritesItsTablesAndRunFolders) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("b/report_static-indoor.html")));
 }
 
+TEST(Benchmark, SequencesTakeTheirGroundTruthFromReferenceFiles) {
+  TempDir dir;
+  const std::string data = cached_dataset("static-indoor", dir.file("data"), 3, true);
+  BenchmarkOptions o;
+  o.sequences = {data + "/frames"};  // frames only: no ground truth of their own
+  o.references = {data + "/poses_gt.txt"};
+  o.methods = {"ndt"};
+  o.ablation = false;
+  o.quiet = true;
+  o.out = dir.file("b");
+  const BenchmarkResult r = run_benchmark(o);
+  ASSERT_EQ(r.sequences.size(), 1u);
+  const BenchmarkCell& cell = r.sequences[0].cells.at("ndt");
+  ASSERT_TRUE(cell.ok) << cell.error;
+  EXPECT_TRUE(cell.run.ate.has_value());
+  EXPECT_EQ(cell.run.ground_truth.size(), 3u);
+
+  o.references.push_back(data + "/poses_gt.txt");  // two references for one sequence
+  try {
+    run_benchmark(o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("2 reference files for 1 sequences"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Benchmark2D, PairTableHasOneRowPerMethodAndIsWrittenAsPrinted) {
   TempDir dir;
   Benchmark2DOptions o;

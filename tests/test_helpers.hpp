@@ -7,11 +7,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
 
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include "scanmatch/core/error.hpp"
 
 #include <cstdio>
 
@@ -58,6 +61,16 @@ inline std::string shared_data(const std::string& relative) {
   const std::filesystem::path p =
       std::filesystem::path(SCANMATCH_SOURCE_DIR) / ".." / "shared" / relative;
   return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+/// The message of the scanmatch::Error that `f` throws; empty when it throws none.
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
 }
 
 struct CliRun {

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <functional>
 #include <iterator>
 
 #include "scanmatch/core/error.hpp"
@@ -14,6 +13,7 @@
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::error_of;
 using scanmatch::testing::TempDir;
 using scanmatch::testing::write_text;
 using Encoding = CloudWriteOptions::Encoding;
@@ -39,15 +39,6 @@ void expect_same(const PointCloud& a, const PointCloud& b) {
   EXPECT_EQ(a.intensity, b.intensity);
   EXPECT_EQ(a.ring, b.ring);
   EXPECT_EQ(a.time, b.time);
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
 }
 
 std::string gzip(const std::string& data) {

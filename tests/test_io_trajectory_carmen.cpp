@@ -1,7 +1,5 @@
 #include <gtest/gtest.h>
 
-#include <functional>
-
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
@@ -10,19 +8,11 @@
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::error_of;
 using scanmatch::testing::TempDir;
 using scanmatch::testing::write_text;
 
 namespace {
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 Trajectory sample_trajectory(bool with_times) {
   Trajectory t;
   for (int i = 0; i < 20; ++i) {

@@ -9,7 +9,7 @@
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/run.hpp"
-#include "scanmatch/sim/simulator.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
@@ -37,9 +37,9 @@ class FramesOnly : public SequenceSource {
 // Runs the defaults on `max_frames` (0: all) of `frames` simulated frames of `preset` into `out`.
 RunSummary run_simulated(const std::string& preset, int frames, std::size_t max_frames,
                          const std::string& out) {
-  sim::SimOptions sim;
-  sim.frames = frames;
-  const auto source = sim::open_sequence("sim:" + preset, sim);
+  SequenceOptions input;
+  input.simulator.frames = static_cast<std::size_t>(frames);
+  const auto source = open_sequence("sim:" + preset, input);
   RunOptions options;
   options.out_dir = out;
   options.max_frames = max_frames;
@@ -80,9 +80,9 @@ TEST(OdometryRun, WritesTheGroundTruthOfTheFramesRunAndItsAte) {
 
 TEST(OdometryRun, WithoutGroundTruthThereIsNoneBesideThePoses) {
   TempDir dir;
-  sim::SimOptions sim;
-  sim.frames = 3;
-  FramesOnly source(sim::open_sequence("sim:static-indoor", sim));
+  SequenceOptions input;
+  input.simulator.frames = 3;
+  FramesOnly source(open_sequence("sim:static-indoor", input));
   RunOptions options;
   options.out_dir = dir.file("run");
   options.quiet = true;

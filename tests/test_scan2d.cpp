@@ -378,7 +378,7 @@ TEST(Map2D, DeskewingStaysStableOnADistortedSequence) {
   // room-2d with motion distortion. Deskewing each scan by the step before it (the keyframe by an
   // older step) once made the poses oscillate and diverge (10 deg per step); both scans are now
   // deskewed by one velocity, which must be no worse than not deskewing at all.
-  const Scans2D input = load_scans_2d("sim:room-2d", 150, 1, true);
+  const Scans2D input = load_scans_2d("sim:room-2d", {}, 150);
   ASSERT_GT(input.rotation_period, 0.0);
   const auto one_step_rotation = [&](bool deskew) {
     Mapper2DConfig config;
@@ -403,7 +403,14 @@ TEST(Map2D, DeskewingStaysStableOnADistortedSequence) {
 
 TEST(Map2D, SimulatedRoomsGiveAMapAlongTheTrueWalls) {
   scanmatch::testing::TempDir dir;
-  const Scans2D input = load_scans_2d("sim:room-2d", 100, 1, false);
+  const Scans2D input = load_scans_2d(
+      "sim:room-2d",
+      [] {
+        SequenceOptions o;
+        o.simulator.motion_distortion = false;
+        return o;
+      }(),
+      100);
   Map2DRunOptions options;
   options.quiet = true;
   // Point-to-line ICP: sparse-icp slides along the hallway, which the Neato's 4 m range makes a
@@ -559,7 +566,7 @@ TEST(Map2D, RealCarmenLogBeatsTheCsmBaseline) {
   options.quiet = true;
   options.mapper.constant_velocity = false;
   options.mapper.registration.search_window = 1.3;
-  const Map2DSummary s = run_map2d(load_scans_2d(log, 300), dir.path().string(), options);
+  const Map2DSummary s = run_map2d(load_scans_2d(log, {}, 300), dir.path().string(), options);
   EXPECT_LT(s.one_step.mean_translation, 0.15);
   EXPECT_LT(s.one_step.median_translation, 0.05);
 }

@@ -8,6 +8,7 @@
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
 
@@ -218,8 +219,8 @@ TEST(SimSimulator, WritesADataSetThatReadersOpen) {
   // The streamed source gives the same frames as the written ones.
   auto folder = open_sequence(dir.file("ds"));
   auto streamed = open_sequence("sim:dynamic-indoor", [] {
-    SimOptions o;
-    o.frames = 4;
+    SequenceOptions o;
+    o.simulator.frames = 4;
     return o;
   }());
   Frame a, b;

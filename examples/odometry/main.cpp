@@ -8,14 +8,14 @@
 
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/odometry/ctf_icp_odometry.hpp"
-#include "scanmatch/sim/simulator.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 
 int main(int argc, char** argv) {
   try {
-    scanmatch::sim::SimOptions sim;
-    sim.frames = 50;
+    scanmatch::SequenceOptions input;
+    input.simulator.frames = 50;
     const auto source =
-        scanmatch::sim::open_sequence(argc > 1 ? argv[1] : "sim:dynamic-outdoor-fast", sim);
+        scanmatch::open_sequence(argc > 1 ? argv[1] : "sim:dynamic-outdoor-fast", input);
 
     scanmatch::OdometryConfig config;  // ctf-icp with the documented defaults
     scanmatch::CtfIcpOdometry odometry(config);

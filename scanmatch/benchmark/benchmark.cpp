@@ -17,6 +17,7 @@
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/preprocessor.hpp"
 #include "scanmatch/registration/methods.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch {
@@ -36,11 +37,14 @@ std::string machine_description() {
 }
 
 BenchmarkCell run_cell(const BenchmarkVariant& v, const std::string& name,
-                       const std::string& data_folder, const BenchmarkOptions& o) {
+                       const std::string& data_folder, const std::string& reference,
+                       const BenchmarkOptions& o) {
   BenchmarkCell cell;
   cell.folder = o.out + "/runs/" + name + "/" + variant_folder_name(v.name);
   try {
-    auto source = open_sequence_folder(data_folder);
+    SequenceOptions input;
+    input.reference = reference;
+    auto source = open_sequence(data_folder, input);
     RunOptions run;
     run.out_dir = cell.folder;
     run.max_frames = o.frames;
@@ -158,9 +162,9 @@ std::string cached_dataset(const std::string& preset, const std::string& data, s
   return folder;
 }
 
-double accuracy_score(const std::string& data_folder, const std::vector<Pose>& poses) {
+double accuracy_score(const std::string& sequence, const std::vector<Pose>& poses) {
   if (poses.size() < 2) return 0.0;
-  auto source = open_sequence_folder(data_folder);
+  auto source = open_sequence(sequence);
   // The score's own frames, the same whatever the method's preprocessing: 0.25 m voxels, no crop.
   PreprocessOptions options;
   options.min_range = 0.0;
@@ -199,18 +203,27 @@ BenchmarkResult run_benchmark(BenchmarkOptions o) {
   result.variants = benchmark_variants(o.methods, o.threads, o.ablation);
   if (o.data.empty()) o.data = o.out + "/data";
   fs::create_directories(o.out);
-  std::vector<std::pair<std::string, std::string>> sequences;  // name, folder
+  if (!o.references.empty() && o.references.size() != o.sequences.size())
+    throw Error(
+        fmt::format("bench: {} reference files for {} sequences (give one per sequence, "
+                    "in order)",
+                    o.references.size(), o.sequences.size()));
+  struct Input {
+    std::string name, spec, reference;
+  };
+  std::vector<Input> sequences;
   for (const auto& preset : o.presets)
-    sequences.emplace_back(preset, cached_dataset(preset, o.data, o.frames, o.quiet));
-  for (const auto& folder : o.sequences)
-    sequences.emplace_back(fs::path(folder).lexically_normal().filename().string(), folder);
+    sequences.push_back({preset, cached_dataset(preset, o.data, o.frames, o.quiet), ""});
+  for (std::size_t i = 0; i < o.sequences.size(); ++i)
+    sequences.push_back({fs::path(o.sequences[i]).lexically_normal().filename().string(),
+                         o.sequences[i], o.references.empty() ? "" : o.references[i]});
 
-  for (const auto& [name, folder] : sequences) {
+  for (const auto& [name, folder, reference] : sequences) {
     BenchmarkSequence sequence;
     sequence.name = name;
     sequence.data_folder = folder;
     for (const auto& v : result.variants) {
-      BenchmarkCell cell = run_cell(v, name, folder, o);
+      BenchmarkCell cell = run_cell(v, name, folder, reference, o);
       if (cell.run.ate) {
         sequence.path_length = cell.ate.path_length;
         sequence.still = cell.ate.path_length < 1e-3;

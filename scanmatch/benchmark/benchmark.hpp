@@ -21,15 +21,18 @@ namespace scanmatch {
 struct BenchmarkOptions {
   /// Simulator presets; both empty: the CTF-ICP paper's five data sets.
   std::vector<std::string> presets;
-  std::vector<std::string> sequences;  ///< sequence folders (with ground truth) to add
-  std::vector<std::string> methods;    ///< empty: every 3D method of the paper comparison
-  std::size_t frames = 0;              ///< per sequence; 0: all
-  int threads = 1;                     ///< per method
-  bool ablation = true;                ///< add "ctf-icp --no-fine" and "--no-map-update"
-  bool quiet = false;                  ///< no progress (failures are still reported on stderr)
-  std::string out;                     ///< output folder (created)
-  std::string data;                    ///< where simulated data sets are kept; empty: OUT/data
-  std::string command_line;            ///< shown above the tables and in the report
+  std::vector<std::string> sequences;  ///< sequences (open_sequence specs) to add
+  /// Ground truth of `sequences` from trajectory files, one per sequence in order (none: each
+  /// sequence's own; see SequenceOptions::reference).
+  std::vector<std::string> references;
+  std::vector<std::string> methods;  ///< empty: every 3D method of the paper comparison
+  std::size_t frames = 0;            ///< per sequence; 0: all
+  int threads = 1;                   ///< per method
+  bool ablation = true;              ///< add "ctf-icp --no-fine" and "--no-map-update"
+  bool quiet = false;                ///< no progress (failures are still reported on stderr)
+  std::string out;                   ///< output folder (created)
+  std::string data;                  ///< where simulated data sets are kept; empty: OUT/data
+  std::string command_line;          ///< shown above the tables and in the report
 };
 
 /// One column of the tables: a method, or an ablation such as "ctf-icp --no-fine".
@@ -79,8 +82,9 @@ std::string cached_dataset(const std::string& preset, const std::string& data, s
 /// The LOAM paper's accuracy score: after alignment by `poses`, the mean squared distance from
 /// each point of a frame to its nearest neighbour in the previous frame (PCL's fitness score,
 /// pairs within 1 m, frames downsampled to 0.25 m), averaged over up to 30 evenly spread
-/// consecutive frame pairs of the sequence folder. m^2; 0 for fewer than two poses.
-double accuracy_score(const std::string& data_folder, const std::vector<Pose>& poses);
+/// consecutive frame pairs of the sequence (an open_sequence spec). m^2; 0 for fewer than two
+/// poses.
+double accuracy_score(const std::string& sequence, const std::vector<Pose>& poses);
 
 /// The tables of finished sequences: columns are `methods`; the ablation table appears when the
 /// variants include it, the KITTI drift table when some path was long enough for it.

@@ -36,7 +36,8 @@ class SequenceSource {
 /// Opens a folder: a KITTI sequence (velodyne/*.bin, optional poses.txt and times.txt), a
 /// simulator data set written by `scanmatch simulate` (frames/, poses_gt.txt, times.txt), or a
 /// folder of .pcd/.ply/.bin frames sorted by name. Throws Error when it holds no frames.
-/// (`sim:PRESET` specs are opened by open_sequence in scanmatch/sim/simulator.hpp.)
+/// Commands open their input with open_sequence (scanmatch/sim/open_sequence.hpp), which calls
+/// this for folders and also opens bags and `sim:PRESET`.
 std::unique_ptr<SequenceSource> open_sequence_folder(const std::string& path,
                                                      const CloudReadOptions& options = {});
 

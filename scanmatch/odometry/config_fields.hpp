@@ -9,8 +9,11 @@
 //                                      const char* help);   // flag nullptr: JSON only
 //   template <class S> void nested(const char* key, S& options);  // a nested object
 // and describe(options, visitor) calls it for every field. Enumerations are named (enum_name,
-// enum_from_name); angles are radians in JSON and Python (the CLI may offer degrees).
+// enum_from_name); angles are radians in JSON and Python (the CLI may offer degrees). A bool
+// field whose flag starts with "--no-" is switched off by it (`--no-fine`: fine_stage = false);
+// any other bool flag switches its field on.
 
+#include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/odometry.hpp"
 #include "scanmatch/odometry/run2d.hpp"
 
@@ -103,10 +106,11 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("fine_kernel_distance", c.fine_kernel_distance, nullptr, "ctf-icp: Cauchy kernel distance, m");
   v("degeneracy_ratio", c.degeneracy_ratio, "--degeneracy-ratio",
     "ctf-icp: eigenvalue ratio below which a direction keeps the prior (0: off)");
-  v("fine_stage", c.fine_stage, nullptr, "ctf-icp: run the fine stage (--no-fine: ablation)");
-  v("map_update", c.map_update, nullptr, "ctf-icp: update the global map (--no-map-update)");
+  v("fine_stage", c.fine_stage, "--no-fine", "Ablation: ctf-icp's coarse NDT stage only");
+  v("map_update", c.map_update, "--no-map-update",
+    "Ablation: ctf-icp's fine stage against the previous frame, no global map");
   v("constant_velocity", c.constant_velocity, nullptr, "constant-velocity motion prior");
-  v("deskew", c.deskew, nullptr, "correct motion distortion (--no-deskew)");
+  v("deskew", c.deskew, "--no-deskew", "Do not correct motion distortion");
   v("deskew_min_translation", c.deskew_min_translation, nullptr, "deskew dead band, m per frame");
   v("deskew_min_rotation", c.deskew_min_rotation, nullptr, "deskew dead band, rad per frame");
   v("max_jump", c.max_jump, nullptr, "results farther from the prior are rejected, m");
@@ -129,6 +133,31 @@ void describe(OdometryConfig& c, Visitor& v) {
     "(0: off)");
   v("threads", c.threads, "--threads", "Threads (1 for fair comparisons)");
   v.nested("registration", c.registration);
+}
+
+// RunOptions' fields that make up a run's result (the exported map); the others belong to one
+// invocation (folder, frame limit, quiet, stop) and are not configuration.
+template <typename Visitor>
+void describe(RunOptions& r, Visitor& v) {
+  v("save", r.write_map, "--save-map", "Write RUNDIR/map.pcd (or .ply)");
+  v("format", r.map_format, "--map-format", "Exported map format: pcd or ply");
+  v("voxel_size", r.map_voxel_size, "--map-export-voxel", "Exported map voxel, m");
+  v("radius", r.map_export_radius, "--map-export-radius",
+    "Export only points within this radius of the last pose, m (0: all)");
+}
+
+// RUNDIR/config.json: the OdometryConfig's keys at the top level, as before "map_export" existed.
+template <typename Visitor>
+void describe(OdometryRunConfig& c, Visitor& v) {
+  describe(c.odometry, v);
+  v.nested("map_export", c.output);
+}
+
+// `register`: the registration's own keys, and the downsampling of both clouds.
+template <typename Visitor>
+void describe(PairRegistrationOptions& p, Visitor& v) {
+  v("voxel_size", p.voxel_size, "--voxel", "Voxel downsampling of both clouds, m (0: none)");
+  describe(p.registration, v);
 }
 
 // 2D: map2d's run (Map2DRunOptions) and what it nests.

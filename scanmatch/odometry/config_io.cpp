@@ -157,11 +157,27 @@ OdometryConfig odometry_config_from_json(const std::string& text, const std::str
 }
 
 OdometryConfig read_odometry_config(const std::string& path, const OdometryConfig& base) {
-  return odometry_config_from_json(read_file_bytes(path), path, base);
+  OdometryRunConfig run_base;
+  run_base.odometry = base;
+  return read_odometry_run_config(path, run_base).odometry;
 }
 
 OdometryConfig override_given_flags(const OdometryConfig& base, const OdometryConfig& given,
                                     const std::function<bool(const std::string&)>& was_given) {
+  return config_override_given(base, given, was_given);
+}
+
+std::string odometry_run_config_to_json(const OdometryRunConfig& config) {
+  return config_to_json(config);
+}
+
+OdometryRunConfig read_odometry_run_config(const std::string& path, const OdometryRunConfig& base) {
+  return config_from_json(read_file_bytes(path), path, base);
+}
+
+OdometryRunConfig override_given_flags(const OdometryRunConfig& base,
+                                       const OdometryRunConfig& given,
+                                       const std::function<bool(const std::string&)>& was_given) {
   return config_override_given(base, given, was_given);
 }
 

@@ -109,7 +109,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) fail(dir, "cannot create the run folder: " + ec.message());
-    write_file_atomic(dir + "/config.json", odometry_config_to_json(config));
+    write_file_atomic(dir + "/config.json", odometry_run_config_to_json({config, options}));
     kitti = std::make_unique<TrajectoryWriter>(dir + "/poses.txt", TrajectoryFormat::kKitti);
     tum = std::make_unique<TrajectoryWriter>(dir + "/poses_tum.txt", TrajectoryFormat::kTum);
     timing = std::make_unique<LineWriter>(dir + "/timing.csv");

@@ -12,7 +12,8 @@
 //                   stage of frame_stats.hpp, frames per second, whether the run was interrupted,
 //                   the error that ended it early, and the ATE when the source has ground truth
 //                   (written atomically at the end, also after such an error)
-//   config.json     the OdometryConfig used (reloadable with --config)
+//   config.json     the OdometryConfig used and the map export options (reloadable with
+//                   --config; scanmatch/odometry/config_io.hpp)
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
 // Per-frame files are appended and flushed frame by frame, so an interrupted run keeps its frames.
 // Timing covers the pipeline only (register_frame), never reading or simulating the frames.

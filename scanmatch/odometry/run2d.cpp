@@ -8,6 +8,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/trajectory.hpp"
@@ -36,30 +37,34 @@ nlohmann::ordered_json error_json(const RelativeError2D& e) {
 
 }  // namespace
 
-Scans2D load_scans_2d(const std::string& spec, std::size_t max_scans, std::uint64_t seed,
-                      bool motion_distortion) {
+Scans2D load_scans_2d(const std::string& spec, const SequenceOptions& options,
+                      std::size_t max_scans) {
   Scans2D out;
-  if (spec.rfind("sim:", 0) == 0) {
-    sim::SimOptions o;
+  if (is_simulator_spec(spec)) {
+    sim::SimOptions o = options.simulator;
     o.preset = spec.substr(4);
-    o.seed = seed;
-    o.motion_distortion = motion_distortion;
     if (max_scans > 0) o.frames = max_scans;
     const sim::Simulator simulator(o);
     if (!simulator.sensor().is_2d())
       throw Error(spec + ": not a 2D preset (the 2D preset is room-2d)");
     for (std::size_t i = 0; i < simulator.size(); ++i) out.scans.push_back(simulator.scan_2d(i));
     out.has_reference = true;
-    if (motion_distortion) out.rotation_period = simulator.sensor().frame_period();
-    out.description = fmt::format("{} (simulated, seed {})", spec, seed);
+    if (o.motion_distortion) out.rotation_period = simulator.sensor().frame_period();
+    out.description = fmt::format("{} (simulated, seed {})", spec, o.seed);
+    return out;
+  }
+  if (!fs::exists(spec))
+    throw Error(spec + ": no such input (a CARMEN log, a 2D data set, a bag or sim:PRESET)");
+  if (is_bag_path(spec)) {
+    out.scans = read_bag_laser_scans(spec, options.topic, max_scans);
+    if (out.scans.empty()) throw Error(spec + ": the topic holds no laser scans");
+    out.description = spec;
     return out;
   }
   std::string path = spec;
   if (fs::is_directory(spec)) {
     path = (fs::path(spec) / "scans.log").string();
     if (!fs::exists(path)) throw Error(spec + ": a folder without scans.log (not a 2D data set)");
-  } else if (!fs::exists(spec)) {
-    throw Error(spec + ": no such file or folder");
   }
   CarmenLog log = read_carmen_log(path);
   if (log.scans.empty()) throw Error(path + ": the log holds no laser scans");

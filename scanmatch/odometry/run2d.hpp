@@ -10,6 +10,7 @@
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/odometry/grid_map.hpp"
 #include "scanmatch/odometry/mapper2d.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch {
 
@@ -22,11 +23,12 @@ struct Scans2D {
   std::string description;
 };
 
-/// A CARMEN log (.log, .log.gz), a folder holding scans.log (a simulated 2D data set) or
-/// `sim:PRESET` with a 2D sensor. Throws Error naming the input and the problem.
-/// `motion_distortion` applies to `sim:` only (false: each scan measured from its start pose).
-Scans2D load_scans_2d(const std::string& spec, std::size_t max_scans = 0, std::uint64_t seed = 1,
-                      bool motion_distortion = true);
+/// A CARMEN log (.log, .log.gz), a folder holding scans.log (a simulated 2D data set),
+/// `sim:PRESET` with a 2D sensor (options.simulator: seed, motion_distortion) or a bag's
+/// LaserScan topic (options.topic); at most `max_scans` scans (0: all). The 2D counterpart of
+/// open_sequence (scanmatch/sim/open_sequence.hpp). Throws Error naming the input and the problem.
+Scans2D load_scans_2d(const std::string& spec, const SequenceOptions& options = {},
+                      std::size_t max_scans = 0);
 
 struct Map2DRunOptions {
   Mapper2DConfig mapper;

@@ -291,12 +291,8 @@ class SimulatedSequence : public SequenceSource {
 };
 }  // namespace
 
-std::unique_ptr<SequenceSource> open_sequence(const std::string& spec, SimOptions options) {
-  if (spec.rfind("sim:", 0) == 0) {
-    options.preset = spec.substr(4);
-    return std::make_unique<SimulatedSequence>(options);
-  }
-  return open_sequence_folder(spec);
+std::unique_ptr<SequenceSource> simulated_sequence(const SimOptions& options) {
+  return std::make_unique<SimulatedSequence>(options);
 }
 
 }  // namespace scanmatch::sim

@@ -90,8 +90,8 @@ struct DatasetSelection {
 void write_dataset(const Simulator& simulator, const std::string& folder, bool quiet,
                    const DatasetSelection& selection = {});
 
-/// `sim:PRESET` generates frames on the fly (options.preset is replaced by PRESET); anything else
-/// is opened with open_sequence_folder.
-std::unique_ptr<SequenceSource> open_sequence(const std::string& spec, SimOptions options = {});
+/// The preset of `options` as a SequenceSource whose frames are simulated on the fly (what
+/// `sim:PRESET` opens: see open_sequence in scanmatch/sim/open_sequence.hpp).
+std::unique_ptr<SequenceSource> simulated_sequence(const SimOptions& options);
 
 }  // namespace scanmatch::sim

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "scanmatch/odometry/run.hpp"
-#include "scanmatch/sim/simulator.hpp"
+#include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch::testing {
 
@@ -12,7 +12,7 @@ inline RunSummary run_peer(const std::string& method, const std::string& preset,
                            std::size_t frames) {
   OdometryConfig config;
   config.method = method;
-  const auto source = sim::open_sequence("sim:" + preset);
+  const auto source = open_sequence("sim:" + preset);
   RunOptions options;
   options.max_frames = frames;
   options.quiet = true;

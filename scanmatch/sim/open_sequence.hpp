@@ -1,0 +1,43 @@
+#pragma once
+// The one place that turns a sequence spec into a SequenceSource: every command and the benchmark
+// open their input here, never a reader of their own. It lives in sim/ because that is the lowest
+// folder that sees the folder readers (io/), bags (io/bag/) and the simulator.
+
+#include <memory>
+#include <string>
+
+#include "scanmatch/io/cloud_io.hpp"
+#include "scanmatch/io/sequence.hpp"
+#include "scanmatch/sim/simulator.hpp"
+
+namespace scanmatch {
+
+struct SequenceOptions {
+  /// Bags: the PointCloud2 or Livox CustomMsg topic (empty: the bag's only cloud topic).
+  std::string topic;
+  /// `sim:PRESET`: seed, frames, sensor, noise... (the preset is replaced by PRESET).
+  sim::SimOptions simulator;
+  /// Folders and KITTI sequences: how each frame file is read.
+  CloudReadOptions cloud;
+  /// A trajectory file (KITTI 3x4 or TUM rows, one pose per frame) used as the ground truth in
+  /// place of the source's own, e.g. a SLAM reference kept beside a folder of frames. Empty: the
+  /// source's own (poses.txt of a KITTI sequence, poses_gt.txt of a data set, the simulator's).
+  /// Its poses are re-expressed in the frame of its first pose, as the run's poses are.
+  /// A KITTI file has no times, so the run writes no poses_gt_tum.txt for it.
+  std::string reference;
+};
+
+/// Opens `spec`:
+///   sim:PRESET                 frames simulated on the fly (options.simulator)
+///   a .bag, .db3 or .mcap file (or a ROS 2 bag folder)   the point clouds of options.topic
+///   a folder                   a KITTI sequence, a simulated data set or frame files, as
+///                              open_sequence_folder (scanmatch/io/sequence.hpp) reads it
+/// Throws Error naming `spec` when it does not exist ("no such sequence"), holds no frames, or
+/// the reference's pose count differs from the frame count.
+std::unique_ptr<SequenceSource> open_sequence(const std::string& spec,
+                                              const SequenceOptions& options = {});
+
+/// True for `sim:PRESET` specs.
+bool is_simulator_spec(const std::string& spec);
+
+}  // namespace scanmatch
