@@ -11,11 +11,11 @@
 #include <thread>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/preprocessor.hpp"
+#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/registration/methods.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
 #include "scanmatch/sim/simulator.hpp"

@@ -11,6 +11,9 @@ namespace scanmatch {
 
 using Pose = Eigen::Isometry3d;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+/// Degrees in one radian (for reports; angles are radians everywhere else).
+inline constexpr double kDegreesPerRadian = 57.29577951308232;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 /// [v]_x: the matrix with skew(v) * w == v.cross(w).

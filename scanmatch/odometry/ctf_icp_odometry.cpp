@@ -27,6 +27,11 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
   if (fine_stage_ && map_.map().size() > 0) {
     const Stopwatch fine_time;
     const FineResult fine = fine_.refine(frame, map_.map(), estimate);
+    const Pose disagreement = estimate.inverse() * fine.pose;
+    stats.coarse_fine_m = disagreement.translation().norm();
+    stats.coarse_fine_deg = rotation_angle(disagreement) * kDegreesPerRadian;
+    stats.fine_paired_fraction =
+        static_cast<double>(fine.paired) / static_cast<double>(frame.size());
     estimate = fine.pose;
     stats.degenerate_directions = fine.degenerate_directions;
     stats.iterations += fine.iterations;

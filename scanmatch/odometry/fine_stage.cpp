@@ -57,6 +57,7 @@ FineResult FineStage::refine(const PointCloud& frame, const GaussianVoxelMap& ma
   FineResult result;
   result.pose = start;
   result.iterations = fine.iterations;
+  result.paired = fine.inliers;
   result.condition_number = fine.condition_number;
   result.registered = fine.inliers >= kMinimumFramePoints;
   if (result.registered) {

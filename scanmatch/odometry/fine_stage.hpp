@@ -16,6 +16,7 @@ struct FineResult {
   Pose pose = Pose::Identity();  ///< in the map frame (the start when not registered)
   bool registered = false;       ///< enough points were paired; false: pose is the start
   int iterations = 0;
+  std::size_t paired = 0;  ///< points paired with a map voxel in the last linearisation
   double condition_number = 0.0;
   int degenerate_directions = 0;  ///< directions left at the start (when registered)
 };

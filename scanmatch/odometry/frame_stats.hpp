@@ -28,6 +28,11 @@ struct FrameStats {
   double condition_number = 0;
   int degenerate_directions = 0;
   bool bridged = false;
+  // Health of the frame: how far to trust it.
+  bool prior_uncertain = false;
+  double prior_miss_m = 0, prior_miss_deg = 0;
+  double fine_paired_fraction = 0;
+  double coarse_fine_m = 0, coarse_fine_deg = 0;
 };
 
 template <typename Stats, typename Visitor>
@@ -46,6 +51,18 @@ void describe(Stats& s, Visitor& v) {
   v("degenerate_directions", s.degenerate_directions,
     "directions the fine stage left at the motion prior");
   v("bridged", s.bridged, "the frame could not be registered: the motion prior was used");
+  v("prior_uncertain", s.prior_uncertain,
+    "the motion prior was not trusted (first motion, irregular time step, after a bridged frame or "
+    "one that missed its prior): other coarse starts and a wider gate");
+  v("prior_miss_m", s.prior_miss_m, "distance of the estimate from the motion prior, m");
+  v("prior_miss_deg", s.prior_miss_deg, "rotation of the estimate from the motion prior, deg");
+  v("fine_paired_fraction", s.fine_paired_fraction,
+    "ctf-icp: fraction of the frame's points paired with a map plane by the fine stage (a thin "
+    "map or little overlap: below about 0.3)");
+  v("coarse_fine_m", s.coarse_fine_m,
+    "ctf-icp: distance between the coarse and the fine result, m (large: the stages disagree)");
+  v("coarse_fine_deg", s.coarse_fine_deg,
+    "ctf-icp: rotation between the coarse and fine result, deg");
 }
 
 namespace frame_stats_detail {

@@ -42,6 +42,10 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
     estimate = predicted;
   }
   estimate = orthonormalized(estimate);
+  stats_.prior_uncertain = prior.uncertain;
+  const Pose miss = predicted.inverse() * estimate;
+  stats_.prior_miss_m = miss.translation().norm();
+  stats_.prior_miss_deg = rotation_angle(miss) * kDegreesPerRadian;
   // A bridged frame keeps the last good velocity rather than one derived from the prior itself.
   if (frames_ > 0) motion_.record(orthonormalized(pose_.inverse() * estimate), stats_.bridged);
   pose_ = estimate;

@@ -61,6 +61,25 @@ nlohmann::ordered_json stages_json(const std::vector<StageStatistics>& stages) {
   return j;
 }
 
+// How far the run can be trusted, from its frames' health records (frame_stats.hpp).
+nlohmann::ordered_json health_json(const std::vector<FrameStats>& frames) {
+  std::size_t uncertain = 0, thin = 0, disagreeing = 0;
+  std::vector<double> paired;
+  for (const FrameStats& f : frames) {
+    uncertain += f.prior_uncertain;
+    disagreeing += f.coarse_fine_m > 0.25 || f.coarse_fine_deg > 3.0;
+    if (f.fine_paired_fraction > 0.0) {
+      paired.push_back(f.fine_paired_fraction);
+      thin += f.fine_paired_fraction < 0.3;
+    }
+  }
+  std::sort(paired.begin(), paired.end());
+  return {{"uncertain_priors", uncertain},
+          {"thin_map_frames", thin},
+          {"coarse_fine_disagreements", disagreeing},
+          {"median_fine_paired_fraction", paired.empty() ? 0.0 : paired[paired.size() / 2]}};
+}
+
 // The keys of `scanmatch eval --json`.
 // The ground truth of the frames run, and the estimate's ATE against it.
 void evaluate(const std::optional<Trajectory>& truth, RunSummary& summary) {
@@ -183,7 +202,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                 {"error", summary.error},
                                 {"frames_per_second", summary.frames_per_second},
                                 {"threads", config.threads},
-                                {"stages", stages_json(summary.stages)}};
+                                {"stages", stages_json(summary.stages)},
+                                {"health", health_json(summary.stats)}};
     if (summary.ate) j["ate"] = ate_json(*summary.ate);
     j["options"] = nlohmann::ordered_json::parse(odometry_config_to_json(config));
     write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");

@@ -52,10 +52,10 @@ struct RunSummary {
   std::string error;  ///< why the source could not deliver a frame (empty: it did not fail)
   /// Every stage of frame_stats.hpp, in its order (zeros before a run).
   std::vector<StageStatistics> stages = stage_statistics({});
-  double frames_per_second = 0.0;       ///< 1000 / mean total ms (pipeline time only)
-  std::vector<double> timestamps;       ///< per frame
-  std::vector<Pose> poses;              ///< per frame, world frame of frame 0
-  std::vector<FrameStats> stats;        ///< per frame
+  double frames_per_second = 0.0;  ///< 1000 / mean total ms (pipeline time only)
+  std::vector<double> timestamps;  ///< per frame
+  std::vector<Pose> poses;         ///< per frame, world frame of frame 0
+  std::vector<FrameStats> stats;   ///< per frame
   /// The source's ground truth for the frames run (empty when it has none), as in poses_gt.txt.
   std::vector<Pose> ground_truth;
   /// ATE of `poses` against `ground_truth`, unaligned (both start at the identity, as the run
