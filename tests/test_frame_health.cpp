@@ -34,7 +34,9 @@ TEST(FrameHealth, ARegularDriveTrustsItsPriorAndPairsMostPointsWithTheMap) {
     odometry.register_frame(sim.frame(i), sim.frame_time(i));
     const FrameStats& s = odometry.last_stats();
     EXPECT_FALSE(s.bridged) << i;
-    if (i == 1) EXPECT_TRUE(s.prior_uncertain);  // no motion measured yet
+    if (i == 1) {
+      EXPECT_TRUE(s.prior_uncertain);  // no motion measured yet
+    }
     if (i < 5) continue;
     EXPECT_FALSE(s.prior_uncertain) << i;
     // Constant velocity on a smooth drive: the estimate stays within centimetres of the prior.
@@ -47,7 +49,7 @@ TEST(FrameHealth, ARegularDriveTrustsItsPriorAndPairsMostPointsWithTheMap) {
 }
 
 TEST(FrameHealth, RealAviaKeyframesShowAThinMap) {
-  const std::string folder = scanmatch::testing::shared_data("3d/avia_hku1/frames");
+  const std::string folder = scanmatch::testing::shared_data("data/3d/avia_hku1/frames");
   if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
   auto source = open_sequence_folder(folder);
   Odometry odometry(OdometryConfig{});
