@@ -55,8 +55,8 @@ class VoxelHashTable {
     if (values_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
       throw Error("voxel hash table: too many voxels");
     slots_[at] = Slot{key, static_cast<std::int32_t>(values_.size())};
-    keys_.push_back(key);
     values_.emplace_back();
+    keys_.push_back(key);
     return {values_.size() - 1, true};
   }
 
@@ -113,8 +113,8 @@ class VoxelHashTable {
   }
   /// Room for this many entries without growing.
   void reserve(std::size_t entries) {
-    keys_.reserve(entries);
     values_.reserve(entries);
+    keys_.reserve(entries);
     if (2 * entries > slots_.size()) rebuild(entries);
   }
 
@@ -141,8 +141,8 @@ class VoxelHashTable {
     }
   }
 
-  std::vector<VoxelKey> keys_;
   std::vector<Value> values_;
+  std::vector<VoxelKey> keys_;
   std::vector<Slot> slots_;
 };
 
