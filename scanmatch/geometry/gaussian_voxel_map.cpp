@@ -17,13 +17,6 @@ GaussianVoxelMap::GaussianVoxelMap(const GaussianVoxelMapOptions& options) : opt
   exact_inverse_ = std::frexp(options.voxel_size, &exponent) == 0.5;
 }
 
-const GaussianVoxel* GaussianVoxelMap::find(const Eigen::Vector3d& p) const {
-  const std::int32_t slot = voxels_.find(index_of(p));
-  if (slot < 0) return nullptr;
-  const GaussianVoxel& v = voxels_.value(static_cast<std::size_t>(slot));
-  return v.count >= options_.min_points ? &v : nullptr;
-}
-
 void GaussianVoxelMap::reserve(std::size_t voxels) {
   voxels_.reserve(voxels);
 }

@@ -91,7 +91,12 @@ class GaussianVoxelMap {
     return voxel_key(p, options_.voxel_size);
   }
   /// The usable voxel (count >= min_points) containing p, or nullptr.
-  const GaussianVoxel* find(const Eigen::Vector3d& p) const;
+  const GaussianVoxel* find(const Eigen::Vector3d& p) const {
+    const std::int32_t slot = voxels_.find(index_of(p));
+    if (slot < 0) return nullptr;
+    const GaussianVoxel& v = voxels_.value(static_cast<std::size_t>(slot));
+    return v.count >= options_.min_points ? &v : nullptr;
+  }
   /// The same, remembering p's voxel in `hint`: a point that stays in its voxel between the
   /// iterations of one registration skips the hash probe. The map must not change while hints
   /// are in use.
