@@ -131,6 +131,9 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("min_downsampled_points", c.min_downsampled_points, nullptr,
     "sparse frames (below 10x this) keeping fewer points get smaller voxels, to voxel_size / 4 "
     "(0: off)");
+  v("dense_sparse_map", c.dense_sparse_map, nullptr,
+    "ctf-icp, sparse frames: the map gets the frame at voxel_size / 4, so one keyframe makes "
+    "usable map voxels");
   v("threads", c.threads, "--threads", "Threads (1 for fair comparisons)");
   v.nested("registration", c.registration);
 }

@@ -5,7 +5,7 @@
 namespace scanmatch {
 
 CtfIcpOdometry::CtfIcpOdometry(const OdometryConfig& config)
-    : OdometryPipeline(config, /*keep_attributes=*/false),
+    : OdometryPipeline(config, /*keep_attributes=*/false, config.dense_sparse_map),
       coarse_(config),
       fine_(config),
       map_(config),
@@ -41,10 +41,10 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
   return estimate;
 }
 
-void CtfIcpOdometry::update_reference(PointCloud frame, const Pose& pose, bool bridged,
-                                      FrameStats& stats) {
+void CtfIcpOdometry::update_reference(PointCloud frame, const PointCloud& map_points,
+                                      const Pose& pose, bool bridged, FrameStats& stats) {
   const Stopwatch map_time;
-  map_.add(frame, pose, frames() == 0);
+  map_.add(map_points.empty() ? frame : map_points, pose, frames() == 0);
   coarse_.set_reference(std::move(frame), bridged);
   stats.map_ms = map_time.ms();
 }

@@ -26,8 +26,8 @@ class CtfIcpOdometry final : public OdometryPipeline {
  private:
   Pose estimate(const PointCloud& frame, const MotionPrior& prior, const Pose& predicted,
                 FrameStats& stats) override;
-  void update_reference(PointCloud frame, const Pose& pose, bool bridged,
-                        FrameStats& stats) override;
+  void update_reference(PointCloud frame, const PointCloud& map_points, const Pose& pose,
+                        bool bridged, FrameStats& stats) override;
 
   CoarseNdt coarse_;
   FineStage fine_;

@@ -16,7 +16,7 @@ RegistrationOptions registration_options(const OdometryConfig& config) {
 }  // namespace
 
 FrameToFrameOdometry::FrameToFrameOdometry(const OdometryConfig& config)
-    : OdometryPipeline(config, /*keep_attributes=*/true),
+    : OdometryPipeline(config, /*keep_attributes=*/true, /*map_points=*/false),
       registration_(registration_options(config)),
       minimum_points_(minimum_points(config.method, config.registration)) {}
 
@@ -34,8 +34,8 @@ Pose FrameToFrameOdometry::estimate(const PointCloud& frame, const MotionPrior& 
   return last_internal_pose() * r.transform;
 }
 
-void FrameToFrameOdometry::update_reference(PointCloud frame, const Pose&, bool bridged,
-                                            FrameStats&) {
+void FrameToFrameOdometry::update_reference(PointCloud frame, const PointCloud&, const Pose&,
+                                            bool bridged, FrameStats&) {
   if (!frame.empty() || !bridged) previous_ = std::move(frame);
 }
 

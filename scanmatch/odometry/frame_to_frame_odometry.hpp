@@ -17,8 +17,8 @@ class FrameToFrameOdometry final : public OdometryPipeline {
  private:
   Pose estimate(const PointCloud& frame, const MotionPrior& prior, const Pose& predicted,
                 FrameStats& stats) override;
-  void update_reference(PointCloud frame, const Pose& pose, bool bridged,
-                        FrameStats& stats) override;
+  void update_reference(PointCloud frame, const PointCloud& map_points, const Pose& pose,
+                        bool bridged, FrameStats& stats) override;
 
   RegistrationOptions registration_;
   std::size_t minimum_points_;

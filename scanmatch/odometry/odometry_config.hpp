@@ -68,6 +68,12 @@ struct OdometryConfig {
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
   std::uint32_t min_downsampled_points = 1000;
+  /// ctf-icp, sparse frames (as above): the map receives the frame filtered at voxel_size / 4,
+  /// not the registration's points. A 0.5 m map voxel on a plane gets at most about 4 points of a
+  /// 0.25 m-filtered frame, fewer than the 5 the fine stage needs: keyframes that turn into new
+  /// view would pair a tenth of their points (docs/odometry.md, "Recorded Avia keyframes").
+  /// Off by default: it helps avia_hku1 and dynamic-outdoor-fast but not dynamic-outdoor.
+  bool dense_sparse_map = false;
   int threads = 1;
   RegistrationOptions registration;  ///< parameters of the frame-to-frame baselines
 };

@@ -5,8 +5,12 @@
 
 namespace scanmatch {
 
-OdometryPipeline::OdometryPipeline(const OdometryConfig& config, bool keep_attributes)
-    : config_(config), preprocessor_(preprocess_options(config, keep_attributes)), motion_(config) {
+OdometryPipeline::OdometryPipeline(const OdometryConfig& config, bool keep_attributes,
+                                   bool map_points)
+    : config_(config),
+      preprocessor_(preprocess_options(config, keep_attributes)),
+      motion_(config),
+      wants_map_points_(map_points) {
   check_odometry_config(config);
   config_.registration.solver.num_threads = config.threads;
 }
@@ -21,7 +25,8 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   // is itself estimation noise feeds that noise back into the next pose.
   const bool deskew = config_.deskew && frames_ > 1 && motion_.moving(motion_.velocity());
   const FrameMotion frame_motion{prior.motion, motion_.frame_period()};
-  PointCloud down = preprocessor_.process(frame, deskew ? &frame_motion : nullptr);
+  PointCloud down = preprocessor_.process(frame, deskew ? &frame_motion : nullptr,
+                                          wants_map_points_ ? &map_points_ : nullptr);
   stats_.points_downsampled = down.size();
   stats_.preprocess_ms = total.ms();
 
@@ -66,7 +71,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
       world_from_internal_ = se3_exp(0.5 * se3_log(velocity));
     reported = world_from_internal_ * reported;
   }
-  update_reference(std::move(down), pose_, stats_.bridged, stats_);
+  update_reference(std::move(down), map_points_, pose_, stats_.bridged, stats_);
   ++frames_;
   stats_.total_ms = total.ms();
   return orthonormalized(reported);

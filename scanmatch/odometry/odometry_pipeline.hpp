@@ -35,8 +35,9 @@ class OdometryPipeline : public FrameOdometry {
   virtual const PointCloud& last_frame() const = 0;
 
  protected:
-  /// `keep_attributes`: the preprocessed frame keeps rings and intensities.
-  OdometryPipeline(const OdometryConfig& config, bool keep_attributes);
+  /// `keep_attributes`: the preprocessed frame keeps rings and intensities; `map_points`: sparse
+  /// frames are also kept at map density for update_reference.
+  OdometryPipeline(const OdometryConfig& config, bool keep_attributes, bool map_points);
 
   /// The internal pose of `frame` (preprocessed) from the motion prior, `predicted` being the last
   /// pose moved by it; frames() > 0. Sets `stats` (stage times, iterations, diagnostics; bridged
@@ -45,8 +46,9 @@ class OdometryPipeline : public FrameOdometry {
                         FrameStats& stats) = 0;
   /// The frame's pose is settled (`bridged`: the prediction): update what the next frame
   /// registers against.
-  virtual void update_reference(PointCloud frame, const Pose& pose, bool bridged,
-                                FrameStats& stats) = 0;
+  /// `map_points`: the frame at map density (Preprocessor::process), empty when `frame` serves.
+  virtual void update_reference(PointCloud frame, const PointCloud& map_points, const Pose& pose,
+                                bool bridged, FrameStats& stats) = 0;
 
  private:
   OdometryConfig config_;
@@ -55,7 +57,10 @@ class OdometryPipeline : public FrameOdometry {
   Pose pose_ = Pose::Identity();  ///< internal pose of the last frame
   Pose world_from_internal_ = Pose::Identity();
   std::size_t frames_ = 0;
-  bool timed_frames_ = false;  ///< the first frame had point times: poses are mid-frame internally
+  bool timed_frames_ = false;
+  bool wants_map_points_;
+  PointCloud map_points_;  ///< the last frame at map density (reused between frames)  ///< the
+                           ///< first frame had point times: poses are mid-frame internally
   FrameStats stats_;
 };
 

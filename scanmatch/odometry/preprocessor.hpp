@@ -41,7 +41,12 @@ class Preprocessor {
   explicit Preprocessor(const PreprocessOptions& options) : options_(options) {}
   /// The frame cropped, deskewed by `motion` (when given; points without a finite time stay as
   /// they are) and downsampled. Inconsistent fields (a time per point missing) give an empty cloud.
-  PointCloud process(const PointCloud& frame, const FrameMotion* motion = nullptr) const;
+  /// `map_points`, when given, receives the same frame at map density: for a frame delivered
+  /// sparse, filtered at voxel_size / 4; empty for a dense one (its registration points serve).
+  PointCloud process(const PointCloud& frame, const FrameMotion* motion = nullptr,
+                     PointCloud* map_points = nullptr) const;
+  /// A frame of `delivered` points is sparse: fewer than 10 x min_downsampled_points.
+  bool sparse(std::size_t delivered) const;
   const PreprocessOptions& options() const { return options_; }
 
  private:
