@@ -114,6 +114,21 @@ DenseTrajectory handheld_along(const GroundPath& path, const Ground* ground, dou
   });
 }
 
+DenseTrajectory walk_along(const GroundPath& path, const Ground* ground, double length,
+                           double duration, double height) {
+  return DenseTrajectory(duration, [&](double t) {
+    const double s = distance_at(t, length, duration);
+    // Peak yaw rate 0.6 * 2 pi * 0.12 + 0.25 * 2 pi * 0.35 ~ 1.0 rad/s (57 deg/s).
+    const double yaw = path.heading(s) + 0.6 * std::sin(2 * M_PI * 0.12 * t) +
+                       0.25 * std::sin(2 * M_PI * 0.35 * t + 0.8);
+    const double roll = 0.04 * std::sin(2 * M_PI * 0.3 * t + 0.5);
+    const double pitch = 0.06 * std::sin(2 * M_PI * 0.25 * t + 1.7);
+    Pose T = pose_on_ground(path.position(s), yaw, ground, height, roll, pitch);
+    T.translation().z() += 0.01 * std::sin(2 * M_PI * 1.8 * t);  // gait bounce
+    return T;
+  });
+}
+
 DenseTrajectory replay(const Trajectory& recorded, const Pose& start, double rate_hz) {
   if (recorded.size() < 2) throw Error("simulator: a replayed trajectory needs at least two poses");
   std::vector<double> times = recorded.timestamps;

@@ -33,6 +33,9 @@ std::vector<PresetInfo> make_presets() {
        1000, 800.0},
       {"handheld-fast", "office", "mid360", "handheld",
        "hand-held sensor with fast rotations in the office", 300, 30.0},
+      {"handheld-walk", "office", "avia", "walk",
+       "hand-held Livox Avia carried at walking pace, looking around (like a hand-held recording)",
+       1200, 72.0},
       {"room-2d", "rooms-2d", "neato", "robot", "2D laser on a robot through a few rooms", 500,
        45.0},
   };
@@ -46,7 +49,7 @@ World make_world(const std::string& scene, std::uint64_t seed) {
 
 double sensor_height(const PresetInfo& p) {
   if (p.motion == "car") return 1.8;
-  if (p.motion == "handheld") return 1.3;
+  if (p.motion == "handheld" || p.motion == "walk") return 1.3;
   if (p.scene == "rooms-2d") return 0.2;
   return 0.5;
 }
@@ -103,6 +106,8 @@ Simulator::Simulator(const SimOptions& options)
     const double length = preset_->path_length * scale;
     if (preset_->motion == "handheld")
       motion_ = handheld_along(path, ground, length, travel_time * scale, height);
+    else if (preset_->motion == "walk")
+      motion_ = walk_along(path, ground, length, travel_time * scale, height);
     else
       motion_ = drive_along(path, ground, length, travel_time * scale, height,
                             preset_->motion == "car" ? 0.003 : 0.006);
