@@ -20,10 +20,6 @@ GaussianVoxelMapOptions grid_options(double resolution) {
   return o;
 }
 
-Pose scaled(const Pose& motion, double factor) {
-  return se3_exp(factor * se3_log(motion));
-}
-
 bool near(const Pose& a, const Pose& b) {
   const Pose d = a.inverse() * b;
   return d.translation().norm() < 0.05 && rotation_angle(d) < 0.01;
@@ -84,8 +80,8 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
   const NdtFactor widened_factor = ndt_factor(source, wide, config_.ndt_neighbours, outliers);
 
   std::vector<Pose> tried;
-  for (const Pose& start : {prior_motion, Pose(Pose::Identity()), scaled(prior_motion, 0.5),
-                            scaled(prior_motion, 2.0)}) {
+  for (const Pose& start : {prior_motion, Pose(Pose::Identity()), scaled_motion(prior_motion, 0.5),
+                            scaled_motion(prior_motion, 2.0)}) {
     bool seen = false;
     for (const Pose& t : tried) seen = seen || near(t, start);
     if (seen) continue;

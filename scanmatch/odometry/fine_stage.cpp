@@ -24,26 +24,6 @@ FineStage::FineStage(const OdometryConfig& config) {
   }
 }
 
-MapFit map_fit(const PointCloud& frame, const GaussianVoxelMap& map, const Pose& pose,
-               double inlier_distance) {
-  MapFit fit;
-  if (frame.empty()) return fit;
-  std::size_t inliers = 0;
-  double sum_d2 = 0.0;
-  for (const Point& p : frame.points) {
-    const Eigen::Vector3d x = pose * p.cast<double>();
-    const GaussianVoxel* v = map.find(x);
-    if (v == nullptr) continue;
-    const double d = std::abs(v->normal.dot(x - v->mean));
-    if (d > inlier_distance) continue;
-    ++inliers;
-    sum_d2 += d * d;
-  }
-  fit.inlier_fraction = static_cast<double>(inliers) / static_cast<double>(frame.size());
-  if (inliers > 0) fit.rms_distance = std::sqrt(sum_d2 / static_cast<double>(inliers));
-  return fit;
-}
-
 FineResult FineStage::refine(const PointCloud& frame, const GaussianVoxelMap& map,
                              const Pose& start) const {
   CtfFineOptions options = options_;

@@ -21,17 +21,6 @@ struct FineResult {
   int degenerate_directions = 0;  ///< directions left at the start (when registered)
 };
 
-/// How well a frame fits the map at a pose: the plane distances of its points to the map voxels
-/// they fall in.
-struct MapFit {
-  double inlier_fraction = 0.0;  ///< of the frame's points, within the inlier distance of a plane
-  double rms_distance = 0.0;     ///< RMS plane distance of those inliers, m
-};
-
-/// The fit of `frame` (sensor frame) placed at `pose` in `map`, inliers within `inlier_distance` m.
-MapFit map_fit(const PointCloud& frame, const GaussianVoxelMap& map, const Pose& pose,
-               double inlier_distance);
-
 class FineStage {
  public:
   explicit FineStage(const OdometryConfig& config);

@@ -9,11 +9,11 @@ namespace {
 /// Time-step ratios this close to 1 count as regular: timestamp jitter is not motion.
 constexpr double kRegularStep = 0.05;
 
-Pose scaled(const Pose& motion, double factor) {
+}  // namespace
+
+Pose scaled_motion(const Pose& motion, double factor) {
   return se3_exp(factor * se3_log(motion));
 }
-
-}  // namespace
 
 MotionModel::MotionModel(const OdometryConfig& config) : config_(config) {}
 
@@ -41,7 +41,7 @@ const MotionPrior& MotionModel::predict(double timestamp, std::size_t frames) {
   } else {
     prior_.scale = ratio;
   }
-  prior_.motion = scaled(velocity_, prior_.scale);
+  prior_.motion = scaled_motion(velocity_, prior_.scale);
   return prior_;
 }
 

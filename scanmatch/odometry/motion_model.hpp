@@ -28,6 +28,9 @@ struct MotionPrior {
   bool uncertain = false;          ///< the coarse stage tries other starts; the gate widens
 };
 
+/// `motion` scaled along its own twist: factor 2 is the same motion twice (constant velocity).
+Pose scaled_motion(const Pose& motion, double factor);
+
 class MotionModel {
  public:
   explicit MotionModel(const OdometryConfig& config);

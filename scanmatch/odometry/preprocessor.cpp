@@ -55,8 +55,8 @@ PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_att
   return o;
 }
 
-bool Preprocessor::sparse(std::size_t delivered) const {
-  return delivered < kDenseFactor * options_.min_downsampled_points;
+bool sparse_frame(std::size_t delivered, const PreprocessOptions& options) {
+  return delivered < kDenseFactor * options.min_downsampled_points;
 }
 
 PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* motion,
@@ -88,7 +88,7 @@ PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* mot
     if (keep_ring) kept.ring.push_back(frame.ring[i]);
     if (keep_intensity) kept.intensity.push_back(frame.intensity[i]);
   }
-  if (map_points != nullptr && sparse(frame.size()))
+  if (map_points != nullptr && sparse_frame(frame.size(), options_))
     *map_points =
         options_.voxel_size > 0.0 ? voxel_downsample(kept, 0.25 * options_.voxel_size) : kept;
   return adaptive_downsample(kept, frame.size(), options_);
@@ -102,7 +102,7 @@ PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
   // Only frames delivered sparse (FAST-LIO keyframes): a dense frame that keeps few points sees a
   // near wall or is mostly within min_range, and finer voxels there did not help (dynamic-indoor:
   // 0.1864 -> 0.1878 % ATE when applied to those frames too).
-  if (!Preprocessor(options).sparse(delivered)) return down;
+  if (!sparse_frame(delivered, options)) return down;
   // Halve the voxel (twice at most) while a sparse frame keeps too few points to register.
   for (int k = 0;
        k < 2 && down.size() < options.min_downsampled_points && down.size() < cloud.size(); ++k) {

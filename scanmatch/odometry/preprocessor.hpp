@@ -45,13 +45,14 @@ class Preprocessor {
   /// sparse, filtered at voxel_size / 4; empty for a dense one (its registration points serve).
   PointCloud process(const PointCloud& frame, const FrameMotion* motion = nullptr,
                      PointCloud* map_points = nullptr) const;
-  /// A frame of `delivered` points is sparse: fewer than 10 x min_downsampled_points.
-  bool sparse(std::size_t delivered) const;
   const PreprocessOptions& options() const { return options_; }
 
  private:
   PreprocessOptions options_;
 };
+
+/// A frame delivered with `delivered` points is sparse: fewer than 10 x min_downsampled_points.
+bool sparse_frame(std::size_t delivered, const PreprocessOptions& options);
 
 /// The adaptive voxel filter alone: voxel_size, then, for a frame delivered with fewer than
 /// 10 x min_downsampled_points points (`delivered`, before the range crop), smaller voxels while
