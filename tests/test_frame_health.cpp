@@ -7,8 +7,11 @@
 #include <filesystem>
 #include <vector>
 
+#include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/sequence.hpp"
+#include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/sim/keyframes.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
 
@@ -80,4 +83,104 @@ TEST(FrameHealth, RealAviaKeyframesShowAThinMapWhichDenseMapPointsThicken) {
   const std::vector<double> thick = avia_paired_fractions(folder, dense);
   EXPECT_GT(thick[0], 2.0 * plain[0]);  // measured 0.24
   EXPECT_GT(median(thick), median(plain));
+}
+
+namespace {
+
+struct Tracked {
+  AteResult ate;
+  std::size_t recoveries = 0;
+};
+
+Tracked track(const std::vector<PointCloud>& frames, const std::vector<double>& times,
+              const std::vector<Pose>& truth, const OdometryConfig& config) {
+  Odometry odometry(config);
+  Tracked t;
+  std::vector<Pose> poses;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    poses.push_back(odometry.register_frame(frames[i], times[i]));
+    t.recoveries += odometry.last_stats().recovered;
+  }
+  t.ate = compute_ate({truth.begin(), truth.begin() + static_cast<std::ptrdiff_t>(poses.size())},
+                      poses);
+  return t;
+}
+
+// The state before turned starts: a turning prior was trusted and no start turned it.
+OdometryConfig without_turned_starts() {
+  OdometryConfig c;
+  c.rotation_starts = 0;
+  c.uncertain_rotation = M_PI;
+  return c;
+}
+
+}  // namespace
+
+TEST(RecordedAvia, KeyframesAreTrackedBelowTwoPercentWithDefaults) {
+  const std::string folder = scanmatch::testing::shared_data("data/3d/avia_hku1");
+  if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
+  // What a user types: the frames folder alone (no times: 0.1 s steps). FAST-LIO2's
+  // LiDAR-inertial poses are the reference. Measured 0.24 % (5.28 % before the turned starts;
+  // KISS-ICP 9.18 %).
+  auto source = open_sequence_folder(folder + "/frames");
+  std::vector<PointCloud> frames;
+  std::vector<double> times;
+  Frame frame;
+  while (source->next(frame)) {
+    frames.push_back(frame.cloud);
+    times.push_back(frame.timestamp);
+  }
+  const Trajectory reference = read_trajectory(folder + "/odom_poses.txt");
+  ASSERT_EQ(reference.size(), frames.size());
+  const Tracked tracked = track(frames, times, reference.poses, OdometryConfig{});
+  EXPECT_LT(tracked.ate.rmse_percent_of_path, 2.0);
+  EXPECT_GT(tracked.recoveries, 0u);  // the record says which frames another start rescued
+}
+
+TEST(RecordedAvia, ItsMotionReplayedInTheSimulatorFailsAlikeAndIsTrackedAfterTheFix) {
+  const std::string poses = scanmatch::testing::shared_data("data/3d/avia_hku1/odom_poses.txt");
+  if (poses.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
+  if (scanmatch::testing::sanitized()) GTEST_SKIP() << "314 frames twice: too slow sanitized";
+  // The recording's own motion (turns of 8-12 degrees between keyframes that move a few
+  // centimetres, sweeps that reverse) through the simulated campus with an Avia, as keyframes
+  // like FAST-LIO2's: the frames that fail are the recording's (13, 26-29, 90...).
+  sim::SimOptions o;
+  o.preset = "dynamic-outdoor";
+  o.sensor = "avia";
+  o.trajectory_file = poses;
+  o.frames = 314;
+  o.motion_distortion = false;
+  const sim::Simulator simulator(o);
+  sim::KeyframeOptions thin;
+  thin.max_points = 5000;
+  thin.point_time = false;
+  std::vector<PointCloud> frames;
+  std::vector<double> times;
+  for (std::size_t i = 0; i < simulator.size(); ++i) {
+    frames.push_back(sim::thin_keyframe(simulator.frame(i), thin, i));
+    times.push_back(simulator.frame_time(i));
+  }
+  const std::vector<Pose>& truth = simulator.ground_truth().poses;
+  const Tracked fixed = track(frames, times, truth, OdometryConfig{});
+  const Tracked before = track(frames, times, truth, without_turned_starts());
+  // Measured 3.0 % against 7.0 % (gicp 12.6 %); what is left are views of one wall.
+  EXPECT_LT(fixed.ate.rmse_percent_of_path, 4.0);
+  EXPECT_GT(before.ate.rmse_percent_of_path, 1.5 * fixed.ate.rmse_percent_of_path);
+}
+
+TEST(HandHeld, FastTurnsInTheOfficeAreTrackedWithTurnedStarts) {
+  if (scanmatch::testing::sanitized()) GTEST_SKIP() << "200 hand-held frames: too slow sanitized";
+  // The intro's named weakness: handheld-fast, 200 frames, 8.3 % ATE before (gicp 3.8 %).
+  sim::SimOptions o;
+  o.preset = "handheld-fast";
+  o.frames = 200;
+  const sim::Simulator simulator(o);
+  std::vector<PointCloud> frames;
+  std::vector<double> times;
+  for (std::size_t i = 0; i < simulator.size(); ++i) {
+    frames.push_back(simulator.frame(i));
+    times.push_back(simulator.frame_time(i));
+  }
+  const Tracked tracked = track(frames, times, simulator.ground_truth().poses, OdometryConfig{});
+  EXPECT_LT(tracked.ate.rmse_percent_of_path, 3.0);  // measured 1.6 %
 }

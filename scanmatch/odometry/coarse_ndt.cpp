@@ -56,12 +56,30 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   result.registered = plain.inliers >= kMinimumFramePoints;
   if (result.registered) result.motion = plain.transform;
   if (prior.uncertain)  // first frames, irregular steps: check other starts
-    result.motion = best_start(source, result.motion, prior.motion, result.iterations);
+    result.motion =
+        best_start(source, result.motion, prior.motion, result.iterations, result.recovered);
   return result;
 }
 
+std::vector<Pose> CoarseNdt::other_starts(const Pose& prior_motion) const {
+  std::vector<Pose> starts = {prior_motion, Pose(Pose::Identity()),
+                              scaled_motion(prior_motion, 0.5), scaled_motion(prior_motion, 2.0)};
+  // About the sensor's z axis: sensors are mounted upright, and hand-held ones sweep mostly about
+  // the vertical. (The prior's own axis was tried: avia_hku1 1.5 % against 0.16 %.)
+  for (int k = 1; k <= config_.rotation_starts; ++k)
+    for (const double side : {-1.0, 1.0}) {
+      Pose turned = prior_motion;
+      turned.linear() =
+          prior_motion.linear() *
+          Eigen::AngleAxisd(side * k * config_.rotation_start_step, Eigen::Vector3d::UnitZ())
+              .toRotationMatrix();
+      starts.push_back(turned);
+    }
+  return starts;
+}
+
 Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                           int& iterations) const {
+                           int& iterations, bool& recovered) const {
   if (!config_.uncertain_starts || reference_.empty()) return plain;
   const double outliers = config_.registration.ndt_outlier_ratio;
   const NdtFactor normal = ndt_factor(source, grid_, config_.ndt_neighbours, outliers);
@@ -80,8 +98,7 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
   const NdtFactor widened_factor = ndt_factor(source, wide, config_.ndt_neighbours, outliers);
 
   std::vector<Pose> tried;
-  for (const Pose& start : {prior_motion, Pose(Pose::Identity()), scaled_motion(prior_motion, 0.5),
-                            scaled_motion(prior_motion, 2.0)}) {
+  for (const Pose& start : other_starts(prior_motion)) {
     bool seen = false;
     for (const Pose& t : tried) seen = seen || near(t, start);
     if (seen) continue;
@@ -97,6 +114,7 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
     if (inliers >= kMinimumFramePoints && cost < best_cost - kScoreMargin * std::abs(best_cost)) {
       best_cost = cost;
       best = refined.transform;
+      recovered = true;
     }
   }
   return best;

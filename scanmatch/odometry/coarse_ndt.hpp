@@ -4,10 +4,13 @@
 // Magnusson's score) from the motion prior. Its job is only to bring the fine stage into its basin.
 //
 // Under an uncertain prior (motion_model.hpp) it also tries other starts: the identity, half and
-// twice the prior, each first on a grid uncertain_ndt_scale times wider, then on the normal grid;
+// twice the prior, and the prior turned about the sensor's z axis by +-k * rotation_start_step
+// (a hand-held sweep that reverses leaves the constant-velocity rotation several degrees off, out
+// of NDT's basin), each first on a grid uncertain_ndt_scale times wider, then on the normal grid;
 // the start whose result scores best on the normal grid (by a margin) wins.
 
 #include <cstddef>
+#include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"
@@ -21,7 +24,9 @@ struct CoarseResult {
   Pose motion = Pose::Identity();  ///< from the reference frame (the prior when not registered)
   bool registered = false;         ///< enough points found a voxel; false: motion is the prior
   int iterations = 0;              ///< every start's iterations
-  double condition_number = 0.0;   ///< of the plain start's information matrix
+  /// Another start beat the prior's own result: the prior was wrong and the frame recovered.
+  bool recovered = false;
+  double condition_number = 0.0;  ///< of the plain start's information matrix
 };
 
 class CoarseNdt {
@@ -37,9 +42,12 @@ class CoarseNdt {
   const PointCloud& reference() const { return reference_; }
 
  private:
-  /// The best motion among `plain` and the other starts (adds their iterations).
+  /// The best motion among `plain` and the other starts (adds their iterations; `recovered`
+  /// when another start won).
   Pose best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                  int& iterations) const;
+                  int& iterations, bool& recovered) const;
+  /// The other starts of an uncertain prior, `prior_motion` first.
+  std::vector<Pose> other_starts(const Pose& prior_motion) const;
 
   OdometryConfig config_;
   SolverOptions solver_;

@@ -122,8 +122,15 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("prior_miss_distance", c.prior_miss_distance, nullptr,
     "an estimate this far from its prior makes the next prior uncertain, m");
   v("prior_miss_angle", c.prior_miss_angle, nullptr, "likewise for rotation, rad");
+  v("uncertain_rotation", c.uncertain_rotation, nullptr,
+    "a prior that turns more than this in one step is uncertain, rad");
   v("uncertain_starts", c.uncertain_starts, nullptr,
-    "ctf-icp, uncertain prior: also try the identity, half and twice the prior motion");
+    "ctf-icp, uncertain prior: also try the identity, half and twice the prior motion and the "
+    "prior turned about the sensor's z axis");
+  v("rotation_starts", c.rotation_starts, nullptr,
+    "ctf-icp, uncertain prior: turned starts per side, +-k * rotation_start_step (0: none)");
+  v("rotation_start_step", c.rotation_start_step, nullptr,
+    "ctf-icp: angle between turned starts, rad");
   v("uncertain_ndt_scale", c.uncertain_ndt_scale, nullptr,
     "ctf-icp: those starts run first on an NDT grid this many times ndt_resolution");
   v("uncertain_jump_scale", c.uncertain_jump_scale, nullptr,

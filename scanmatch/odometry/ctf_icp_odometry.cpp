@@ -22,6 +22,7 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
   Pose estimate = last_internal_pose() * coarse.motion;
   stats.iterations = coarse.iterations;
   stats.condition_number = coarse.condition_number;
+  stats.recovered = coarse.recovered;
   stats.coarse_ms = coarse_time.ms();
 
   if (fine_stage_ && map_.map().size() > 0) {

@@ -30,6 +30,7 @@ struct FrameStats {
   bool bridged = false;
   // Health of the frame: how far to trust it.
   bool prior_uncertain = false;
+  bool recovered = false;
   double prior_miss_m = 0, prior_miss_deg = 0;
   double fine_paired_fraction = 0;
   double coarse_fine_m = 0, coarse_fine_deg = 0;
@@ -54,6 +55,9 @@ void describe(Stats& s, Visitor& v) {
   v("prior_uncertain", s.prior_uncertain,
     "the motion prior was not trusted (first motion, irregular time step, after a bridged frame or "
     "one that missed its prior): other coarse starts and a wider gate");
+  v("recovered", s.recovered,
+    "ctf-icp: another coarse start (the identity, a scaled or a turned prior) scored better than "
+    "the prior's own result, and replaced it");
   v("prior_miss_m", s.prior_miss_m, "distance of the estimate from the motion prior, m");
   v("prior_miss_deg", s.prior_miss_deg, "rotation of the estimate from the motion prior, deg");
   v("fine_paired_fraction", s.fine_paired_fraction,

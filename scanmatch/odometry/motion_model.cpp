@@ -27,13 +27,19 @@ const MotionPrior& MotionModel::predict(double timestamp, std::size_t frames) {
   if (!config_.constant_velocity) return prior_;  // the previous pose is the guess
   // Frame 1 has no motion yet (the identity), and a bridged frame's motion was not measured.
   prior_.uncertain = frames == 1 || previous_bridged_ || previous_missed_;
-  if (!config_.time_scaled_prior || frames < 2) return prior_;
+  if (config_.time_scaled_prior && frames >= 2) scale_by_time_step();
+  // A sharp turn is guessed as badly as it is large: a hand-held sweep reverses at any time.
+  if (rotation_angle(prior_.motion) > config_.uncertain_rotation) prior_.uncertain = true;
+  return prior_;
+}
+
+void MotionModel::scale_by_time_step() {
   if (!(step_ > 0.0) || !(velocity_period_ > 0.0)) {
     prior_.uncertain = true;  // no usable stamps: the step is unknown
-    return prior_;
+    return;
   }
   const double ratio = step_ / velocity_period_;
-  if (std::abs(ratio - 1.0) <= kRegularStep) return prior_;
+  if (std::abs(ratio - 1.0) <= kRegularStep) return;
   if (ratio > config_.max_step_ratio || ratio < 1.0 / config_.max_step_ratio) {
     // A gap (dropped frames) or a burst: scale within bounds, but trust it less.
     prior_.uncertain = true;
@@ -42,7 +48,6 @@ const MotionPrior& MotionModel::predict(double timestamp, std::size_t frames) {
     prior_.scale = ratio;
   }
   prior_.motion = scaled_motion(velocity_, prior_.scale);
-  return prior_;
 }
 
 bool MotionModel::within_gate(const Pose& predicted, const Pose& estimate) const {

@@ -6,9 +6,9 @@
 //   the frame time steps (keyframe folders have irregular steps).
 // - The prior is *uncertain* for the first registered frame, when the time stamps do not increase
 //   or their ratio is outside [1/max_step_ratio, max_step_ratio], after a bridged frame, and after
-//   a frame whose estimate missed its prior by more than prior_miss_distance / prior_miss_angle.
-//   An uncertain prior makes the coarse stage try other starts and widens the gate by
-//   uncertain_jump_scale.
+//   a frame whose estimate missed its prior by more than prior_miss_distance / prior_miss_angle,
+//   and when the prior turns more than uncertain_rotation in one step. An uncertain prior makes the
+//   coarse stage try other starts and widens the gate by uncertain_jump_scale.
 // - A bridged frame (no usable registration) keeps the last measured velocity: its own motion is
 //   the prior itself, not a measurement.
 //
@@ -52,6 +52,9 @@ class MotionModel {
   void record(const Pose& motion, bool bridged);
 
  private:
+  /// Scales prior_ by the ratio of this time step to the last motion's (uncertain beyond bounds).
+  void scale_by_time_step();
+
   OdometryConfig config_;
   MotionPrior prior_;
   Pose velocity_ = Pose::Identity();

@@ -33,6 +33,11 @@ void check_odometry_config(const OdometryConfig& c) {
   if (c.merge_threshold == 0) throw Error("odometry: merge_threshold must be at least 1");
   if (c.threads < 1) throw Error("odometry: threads must be at least 1");
   if (!(c.max_step_ratio >= 1.0)) throw Error("odometry: max_step_ratio must be at least 1");
+  if (!(c.uncertain_rotation > 0.0) || !(c.rotation_start_step > 0.0) ||
+      !(c.rotation_start_step < M_PI) || c.rotation_starts < 0 || c.rotation_starts > 18)
+    throw Error(
+        "odometry: uncertain_rotation and rotation_start_step must be positive (the step below "
+        "pi) and rotation_starts within 0..18");
   if (!(c.uncertain_ndt_scale >= 1.0) || !(c.uncertain_jump_scale >= 1.0))
     throw Error("odometry: uncertain_ndt_scale and uncertain_jump_scale must be at least 1");
   positive(c.prior_miss_distance, "prior_miss_distance");

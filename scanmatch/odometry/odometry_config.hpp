@@ -61,10 +61,19 @@ struct OdometryConfig {
   /// A frame whose estimate lies farther than this from its prior makes the next prior uncertain.
   double prior_miss_distance = 0.2;  ///< m
   double prior_miss_angle = 0.05;    ///< rad
-  /// ctf-icp, uncertain prior: try other coarse starts (identity, half and twice the prior).
+  /// A prior that turns more than this in one step is uncertain: a constant-velocity guess of a
+  /// sensor that turns by hand (or keyframes taken every few degrees) misses by about as much as it
+  /// turns, while a vehicle at 10 Hz turns a degree or two a frame (docs/odometry.md, "Recorded
+  /// Avia keyframes").
+  double uncertain_rotation = 0.05;  ///< rad
+  /// ctf-icp, uncertain prior: try other coarse starts (identity, half and twice the prior, and
+  /// the prior turned about the sensor's z axis by +-k * rotation_start_step, k
+  /// = 1..rotation_starts).
   bool uncertain_starts = true;
-  double uncertain_ndt_scale = 3.0;   ///< the other starts run first on this times ndt_resolution
-  double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
+  int rotation_starts = 2;              ///< turned starts per side (0: none)
+  double rotation_start_step = 0.0873;  ///< rad (5 deg)
+  double uncertain_ndt_scale = 3.0;     ///< the other starts run first on this times ndt_resolution
+  double uncertain_jump_scale = 3.0;    ///< max_jump and max_jump_angle widen by this factor
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
   std::uint32_t min_downsampled_points = 1000;

@@ -63,10 +63,11 @@ nlohmann::ordered_json stages_json(const std::vector<StageStatistics>& stages) {
 
 // How far the run can be trusted, from its frames' health records (frame_stats.hpp).
 nlohmann::ordered_json health_json(const std::vector<FrameStats>& frames) {
-  std::size_t uncertain = 0, thin = 0, disagreeing = 0;
+  std::size_t uncertain = 0, recovered = 0, thin = 0, disagreeing = 0;
   std::vector<double> paired;
   for (const FrameStats& f : frames) {
     uncertain += f.prior_uncertain;
+    recovered += f.recovered;
     disagreeing += f.coarse_fine_m > 0.25 || f.coarse_fine_deg > 3.0;
     if (f.fine_paired_fraction > 0.0) {
       paired.push_back(f.fine_paired_fraction);
@@ -75,6 +76,7 @@ nlohmann::ordered_json health_json(const std::vector<FrameStats>& frames) {
   }
   std::sort(paired.begin(), paired.end());
   return {{"uncertain_priors", uncertain},
+          {"recoveries", recovered},
           {"thin_map_frames", thin},
           {"coarse_fine_disagreements", disagreeing},
           {"median_fine_paired_fraction", paired.empty() ? 0.0 : paired[paired.size() / 2]}};
