@@ -7,6 +7,7 @@
 #include "apps/commands.hpp"
 #include "scanmatch/benchmark/benchmark.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
+#include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch::cli {
 
@@ -15,7 +16,9 @@ void add_bench_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "bench", "Every method on every sequence in one run: the papers' tables and a report");
   cmd->add_option("--preset", o->presets,
-                  "Simulator presets (default: the CTF-ICP paper's five data sets)");
+                  "Simulator presets (default: the CTF-ICP paper's five data sets); repeat or "
+                  "separate by commas")
+      ->delimiter(',');
   cmd->add_option("--sequence", o->sequences,
                   "Sequences to add (folders, KITTI sequences, bags; with ground truth for ATE)");
   cmd->add_option("--reference", o->references,
@@ -24,13 +27,31 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--method,--methods", o->methods,
                   "Methods (default: ctf-icp icp ndt gicp vgicp loam point-to-plane "
                   "point-to-line; any of " +
-                      odometry_methods_with_peers() + ")");
+                      odometry_methods_with_peers() + "); repeat or separate by commas")
+      ->delimiter(',');
   cmd->add_option("--frames", o->frames, "Frames per sequence (0: all)");
   cmd->add_option("--threads", o->threads, "Threads per method")->capture_default_str();
   cmd->add_flag("!--no-ablation", o->ablation, "Skip ctf-icp --no-fine and --no-map-update");
   cmd->add_option("--data", o->data, "Where simulated data sets are kept (default OUT/data)");
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_flag("--quiet", o->quiet, "No progress");
+  // For scripts choosing methods: one line per method, peers this build lacks marked.
+  cmd->add_flag_callback(
+      "--list-methods",
+      [] {
+        std::printf("ctf-icp\n");
+        for (const std::string& method : registration_method_names())
+          std::printf("%s\n", method.c_str());
+        for (const std::string& peer : known_odometry_peers()) {
+          const std::string missing = missing_peer_option(peer);
+          if (missing.empty())
+            std::printf("%s\n", peer.c_str());
+          else
+            std::printf("%s not-built (%s)\n", peer.c_str(), missing.c_str());
+        }
+        throw CLI::Success();
+      },
+      "Print the methods, one a line; peers this build lacks are marked not-built");
   cmd->callback([o] {
     BenchmarkOptions options = *o;
     options.command_line = "scanmatch bench";

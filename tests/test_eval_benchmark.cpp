@@ -57,12 +57,12 @@ TEST(Benchmark, VariantsAddTheAblationsOfCtfIcpAndNameTheirFolders) {
 
 TEST(Benchmark, TablesPutEachSequenceAndVariantInItsCell) {
   const auto variants = benchmark_variants({"ctf-icp", "ndt"}, 1, true);
-  BenchmarkSequence moving{"moving", "", false, 100.0, {}};
+  BenchmarkSequence moving{"moving", "", "", false, 100.0, {}};
   moving.cells["ctf-icp"] = finished(1.23456, 0, 0, 2);
   moving.cells["ndt"].error = "diverged";  // failed
   moving.cells["ctf-icp --no-fine"] = finished(4.0, 0, 0, 0);
   moving.cells["ctf-icp --no-map-update"] = finished(5.0, 0, 0, 0);
-  BenchmarkSequence still{"still", "", true, 0.0, {}};
+  BenchmarkSequence still{"still", "", "", true, 0.0, {}};
   still.cells["ctf-icp"] = finished(0, 0.01, 0.02, 0);
   const auto tables = benchmark_tables({moving, still}, variants, {"ctf-icp", "ndt"});
 
@@ -80,6 +80,12 @@ TEST(Benchmark, TablesPutEachSequenceAndVariantInItsCell) {
   ASSERT_NE(fps, nullptr);
   EXPECT_EQ(fps->rows.size(), 2u);
   EXPECT_EQ(fps->rows[0][1], "12.3");
+  const ResultTable* side = table_titled(tables, "ATE and frames per second side by side");
+  ASSERT_NE(side, nullptr);
+  EXPECT_EQ(side->header,
+            (std::vector<std::string>{"method", "moving ATE %", "moving frames/s"}));  // not still
+  EXPECT_EQ(side->rows.at(0), (std::vector<std::string>{"ctf-icp", "1.235 (2 bridged)", "12.3"}));
+  EXPECT_EQ(side->rows.at(1), (std::vector<std::string>{"ndt", "failed", "failed"}));
   // No path reached the 100 m of a KITTI segment: the drift table only shows because a run
   // failed, and without the ablation variants there is no ablation table.
   const ResultTable* kitti = table_titled(tables, "KITTI drift");

@@ -94,6 +94,28 @@ TEST(Rpe, KnownPerStepRotationError) {
   EXPECT_NEAR(by_distance.rotation_mean, 0.005 * 180.0 / M_PI, 1e-9);
 }
 
+TEST(Rpe, RelativeErrorsLocateTheBadStep) {
+  // One step of the estimate is 0.3 m too long and turned 2 degrees; the others are exact.
+  const auto gt = straight_line(10, 1.0);
+  std::vector<Pose> est = {gt[0]};
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    Pose step = gt[i - 1].inverse() * gt[i];
+    if (i == 6) step = step * from_xyz_rpy(0.3, 0, 0, 0, 0, 2.0 * M_PI / 180.0);
+    est.push_back(est.back() * step);
+  }
+  const RelativeErrors e = relative_errors(gt, est, 1);
+  ASSERT_EQ(e.translation.size(), 9u);
+  ASSERT_EQ(e.rotation.size(), 9u);
+  for (std::size_t k = 0; k < e.translation.size(); ++k) {
+    // Entry k is the step from pose k to pose k + 1: the bad one is entry 5.
+    EXPECT_NEAR(e.translation[k], k == 5 ? 0.3 : 0.0, 1e-9) << k;
+    EXPECT_NEAR(e.rotation[k], k == 5 ? 2.0 : 0.0, 1e-9) << k;
+  }
+  // compute_rpe_frames summarises the same errors.
+  EXPECT_NEAR(compute_rpe_frames(gt, est, 1).translation_rmse, std::sqrt(0.09 / 9.0), 1e-9);
+  EXPECT_THROW(relative_errors(gt, est, 0), Error);
+}
+
 TEST(KittiDrift, OnePercentScaleDriftOnStraightLine) {
   // The estimate travels 1 % too far. The devkit normalises by the nominal length while its last
   // frame lies one step beyond it, so the figure is 1 % * (L + step) / L, averaged.
@@ -124,6 +146,8 @@ TEST(Associate, ByIndexRefusesMismatchUnlessPartial) {
   EXPECT_THROW(associate(gt, est), Error);
   const Association a = associate(gt, est, true);
   EXPECT_EQ(a.estimate.size(), 8u);
+  EXPECT_EQ(a.estimate_index.size(), 8u);
+  EXPECT_EQ(a.estimate_index.back(), 7u);
   EXPECT_FALSE(a.by_timestamp);
 }
 
@@ -138,6 +162,7 @@ TEST(Associate, ByTimestampMatchesNearest) {
   EXPECT_TRUE(a.by_timestamp);
   EXPECT_TRUE(a.ground_truth[0].isApprox(gt.poses[2]));
   EXPECT_TRUE(a.ground_truth[1].isApprox(gt.poses[5]));
+  EXPECT_EQ(a.estimate_index, (std::vector<std::size_t>{0, 1}));
   EXPECT_THROW(associate(gt, est, false), Error);  // 2 of 10 matched
 }
 

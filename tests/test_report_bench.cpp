@@ -2,17 +2,21 @@
 // in headless Chromium when it is installed.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <fstream>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/eval/table.hpp"
+#include "scanmatch/odometry/frame_odometry.hpp"
+#include "scanmatch/odometry/report.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
 using scanmatch::testing::run_cli;
+using scanmatch::testing::shared_data;
 using scanmatch::testing::TempDir;
 
 namespace {
@@ -56,8 +60,10 @@ TEST(Report, OdometryRunsBecomeOneSelfContainedPage) {
                          dir.file("report.html"));
   ASSERT_EQ(r.status, 0) << r.output;
   const std::string html = read_text(dir.file("report.html"));
-  // Top view, error over distance, stage times of both runs, the map from above and the side.
-  EXPECT_EQ(count(html, "<svg"), 6u);
+  // Top view, error over distance, stage times of both runs, the map from above and the side;
+  // per run the step error (translation, rotation) and the health record (ctf-icp adds its
+  // coarse/fine disagreement; ndt has no such stages).
+  EXPECT_EQ(count(html, "<svg"), 6u + 4u + 3u);
   EXPECT_NE(html.find("ground truth"), std::string::npos);
   EXPECT_EQ(html.find("http://www.w3.org/2000/svg") != std::string::npos, true);
   EXPECT_EQ(count(html, "<script"), 0u);  // nothing to fetch, nothing to run
@@ -80,8 +86,55 @@ TEST(Report, OdometryRunsBecomeOneSelfContainedPage) {
       " 2>/dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0);
   const std::string rendered = read_text(dom);
-  EXPECT_EQ(count(rendered, "<svg"), 6u);
+  EXPECT_EQ(count(rendered, "<svg"), 6u + 4u + 3u);
   EXPECT_NE(rendered.find("Position error over distance"), std::string::npos);
+}
+
+TEST(Report, EachRunShowsItsStepErrorAndHealthOverFrames) {
+  TempDir dir;
+  const std::string with = dir.file("with_ref"), without = dir.file("no_ref");
+  ASSERT_EQ(
+      run_cli("odometry sim:dynamic-outdoor-fast --frames 8 --quiet --method ctf-icp --out " + with)
+          .status,
+      0);
+  // Every run folder counts its health flags, the recoveries among them.
+  const auto summary = nlohmann::json::parse(scanmatch::testing::read_text(with + "/summary.json"));
+  for (const char* key : {"uncertain_priors", "recoveries", "thin_map_frames",
+                          "coarse_fine_disagreements", "median_fine_paired_fraction"})
+    EXPECT_TRUE(summary.at("health").contains(key)) << key;
+  // The same run without its ground truth: nothing to measure the steps against.
+  std::filesystem::copy(with, without);
+  std::filesystem::remove(without + "/poses_gt.txt");
+  std::filesystem::remove(without + "/poses_gt_tum.txt");
+  const std::string html =
+      render_report({read_run_folder(with), read_run_folder(without)}, std::nullopt);
+  const auto at_with = html.find("<h3>with_ref (ctf-icp)"),
+             at_without = html.find("<h3>no_ref (ctf-icp)");
+  ASSERT_NE(at_with, std::string::npos);
+  ASSERT_NE(at_without, std::string::npos);
+  ASSERT_LT(at_with, at_without);
+  const std::string with_part = html.substr(at_with, at_without - at_with);
+  const std::string without_part =
+      html.substr(at_without, html.find("<h2>", at_without) - at_without);
+
+  // With a reference: translation and rotation error of every step, the health record, and the
+  // worst steps named with what the record said there.
+  EXPECT_EQ(count(with_part, "Step error against the reference: translation"), 1u);
+  EXPECT_EQ(count(with_part, "Step error against the reference: rotation"), 1u);
+  EXPECT_EQ(count(with_part, "Health: map pairing and flagged frames"), 1u);
+  EXPECT_NE(with_part.find("worst steps"), std::string::npos);
+  EXPECT_EQ(with_part.find("No step-error plot"), std::string::npos);
+  // The thresholds summary.json counts with, drawn and stated.
+  EXPECT_NE(with_part.find("thin map below 0.3"), std::string::npos);
+  EXPECT_NE(with_part.find("recovered by another coarse start on"), std::string::npos);
+  EXPECT_NE(with_part.find("more than 0.25 m or 3 deg"), std::string::npos);
+  EXPECT_NE(with_part.find("stroke-dasharray"), std::string::npos);
+
+  // Without: the health plot only, and why there is no error plot.
+  EXPECT_EQ(without_part.find("Step error against the reference"), std::string::npos);
+  EXPECT_EQ(count(without_part, "Health: map pairing and flagged frames"), 1u);
+  EXPECT_NE(without_part.find("No step-error plot: this run has no reference"), std::string::npos);
+  EXPECT_EQ(count(html, "<script"), 0u);
 }
 
 TEST(Bench, OneRunGivesEveryTableForEveryMethod) {
@@ -103,4 +156,46 @@ TEST(Bench, OneRunGivesEveryTableForEveryMethod) {
   const auto bad = run_cli("bench --method magic --out " + dir.file("c"));
   EXPECT_NE(bad.status, 0);
   EXPECT_NE(bad.output.find("magic"), std::string::npos);
+}
+
+TEST(Bench, RecordedFolderUsesTheReferenceBesideItsFrames) {
+  TempDir dir;
+  // A folder like avia_hku1: frames/, times.txt and a SLAM reference named odom_poses.txt.
+  const std::string rec = dir.file("rec");
+  ASSERT_EQ(run_cli("simulate dynamic-outdoor-fast --frames 6 --quiet --out " + rec).status, 0);
+  std::filesystem::rename(rec + "/poses_gt.txt", rec + "/odom_poses.txt");
+  const auto r =
+      run_cli("bench --sequence " + rec +
+              " --method ctf-icp,ndt,kiss-icp --no-ablation --quiet --out " + dir.file("b"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string md = read_text(dir.file("b/tables.md"));
+  EXPECT_NE(md.find("Reference of rec: `" + rec + "/odom_poses.txt`"), std::string::npos) << md;
+  // ATE and frames per second, per method, side by side.
+  EXPECT_NE(md.find("| method | rec ATE % | rec frames/s |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| ctf-icp | "), std::string::npos);
+  EXPECT_EQ(md.find("failed"), std::string::npos) << md;
+  if (missing_peer_option("kiss-icp").empty()) return;  // a build with KISS-ICP runs it
+  // A peer this build lacks is listed as such, not a failure of the bench.
+  EXPECT_NE(md.find("| kiss-icp | not built | not built |"), std::string::npos) << md;
+  EXPECT_NE(md.find("Not built into this binary: kiss-icp"), std::string::npos);
+  const auto list = run_cli("bench --list-methods");
+  EXPECT_EQ(list.status, 0) << list.output;
+  EXPECT_NE(list.output.find("\nkiss-icp not-built"), std::string::npos) << list.output;
+  EXPECT_NE(list.output.find("ctf-icp\n"), std::string::npos);
+}
+
+TEST(Bench, RecordedAviaHku1AgainstItsReference) {
+  const std::string avia = shared_data("data/3d/avia_hku1");
+  if (avia.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 absent: recorded bench not run";
+  TempDir dir;
+  const auto r = run_cli("bench --sequence " + avia + " --reference " + avia +
+                         "/odom_poses.txt --method ctf-icp,ndt --frames 10 --no-ablation "
+                         "--quiet --out " +
+                         dir.file("b"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string md = read_text(dir.file("b/tables.md"));
+  EXPECT_NE(md.find("| avia_hku1 | "), std::string::npos) << md;
+  EXPECT_NE(md.find("| method | avia_hku1 ATE % | avia_hku1 frames/s |"), std::string::npos);
+  EXPECT_EQ(md.find("failed"), std::string::npos) << md;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("b/runs/avia_hku1/ctf-icp/poses_gt.txt")));
 }

@@ -41,6 +41,11 @@ BenchmarkCell run_cell(const BenchmarkVariant& v, const std::string& name,
                        const BenchmarkOptions& o) {
   BenchmarkCell cell;
   cell.folder = o.out + "/runs/" + name + "/" + variant_folder_name(v.name);
+  if (!v.not_built.empty()) {
+    cell.not_built = true;
+    cell.error = "not built";
+    return cell;
+  }
   try {
     SequenceOptions input;
     input.reference = reference;
@@ -76,6 +81,12 @@ std::string write_outputs(const BenchmarkOptions& o, const BenchmarkResult& r) {
       "Command: `{}`\n\nMachine: {}. Date: {}. Frames per sequence: {}. Threads: {}.\n\n",
       o.command_line, machine_description(), date, o.frames > 0 ? std::to_string(o.frames) : "all",
       o.threads);
+  for (const auto& s : r.sequences)
+    if (!s.reference.empty()) md += fmt::format("Reference of {}: `{}`.\n\n", s.name, s.reference);
+  for (const auto& v : r.variants)
+    if (!v.not_built.empty())
+      md += fmt::format("Not built into this binary: {} (configure with {}).\n\n", v.name,
+                        v.not_built);
   std::string csv, html_tables;
   for (const auto& t : r.tables) {
     md += to_markdown(t);
@@ -111,17 +122,19 @@ std::vector<BenchmarkVariant> benchmark_variants(const std::vector<std::string>&
     OdometryConfig c;
     c.method = method;
     c.threads = threads;
-    make_frame_odometry(c);  // rejects unknown methods (and peers not built) before any work
-    v.push_back({method, c});
+    // A known peer this build lacks is listed as such; anything else unusable stops here.
+    const std::string missing = missing_peer_option(method);
+    if (missing.empty()) make_frame_odometry(c);
+    v.push_back({method, c, missing});
   }
   if (ablation && std::find(methods.begin(), methods.end(), "ctf-icp") != methods.end()) {
     OdometryConfig c;
     c.threads = threads;
     c.fine_stage = false;
-    v.push_back({"ctf-icp --no-fine", c});
+    v.push_back({"ctf-icp --no-fine", c, ""});
     c.fine_stage = true;
     c.map_update = false;
-    v.push_back({"ctf-icp --no-map-update", c});
+    v.push_back({"ctf-icp --no-map-update", c, ""});
   }
   return v;
 }
@@ -214,14 +227,27 @@ BenchmarkResult run_benchmark(BenchmarkOptions o) {
   std::vector<Input> sequences;
   for (const auto& preset : o.presets)
     sequences.push_back({preset, cached_dataset(preset, o.data, o.frames, o.quiet), ""});
-  for (std::size_t i = 0; i < o.sequences.size(); ++i)
-    sequences.push_back({fs::path(o.sequences[i]).lexically_normal().filename().string(),
-                         o.sequences[i], o.references.empty() ? "" : o.references[i]});
+  for (std::size_t i = 0; i < o.sequences.size(); ++i) {
+    std::string reference = o.references.empty() ? "" : o.references[i];
+    // A reference kept beside the frames (avia_hku1's odom_poses.txt) serves when the source
+    // has no ground truth of its own.
+    if (reference.empty()) {
+      const std::string beside = reference_beside(o.sequences[i]);
+      if (!beside.empty() && !open_sequence(o.sequences[i])->ground_truth()) reference = beside;
+      if (!reference.empty() && !o.quiet)
+        std::fprintf(stderr, "bench: %s: reference %s (found beside the frames)\n",
+                     o.sequences[i].c_str(), reference.c_str());
+    }
+    fs::path path = fs::path(o.sequences[i]).lexically_normal();
+    if (path.filename().empty()) path = path.parent_path();  // "folder/"
+    sequences.push_back({path.filename().string(), o.sequences[i], reference});
+  }
 
   for (const auto& [name, folder, reference] : sequences) {
     BenchmarkSequence sequence;
     sequence.name = name;
     sequence.data_folder = folder;
+    sequence.reference = reference;
     for (const auto& v : result.variants) {
       BenchmarkCell cell = run_cell(v, name, folder, reference, o);
       if (cell.run.ate) {

@@ -23,7 +23,8 @@ struct BenchmarkOptions {
   std::vector<std::string> presets;
   std::vector<std::string> sequences;  ///< sequences (open_sequence specs) to add
   /// Ground truth of `sequences` from trajectory files, one per sequence in order (none: each
-  /// sequence's own; see SequenceOptions::reference).
+  /// sequence's own, or else a reference kept beside its frames, see reference_beside(); see
+  /// SequenceOptions::reference).
   std::vector<std::string> references;
   std::vector<std::string> methods;  ///< empty: every 3D method of the paper comparison
   std::size_t frames = 0;            ///< per sequence; 0: all
@@ -39,11 +40,15 @@ struct BenchmarkOptions {
 struct BenchmarkVariant {
   std::string name;
   OdometryConfig config;
+  /// A peer this build lacks: the CMake option that builds it. Its cells read "not built" and
+  /// the bench goes on without it.
+  std::string not_built;
 };
 
 struct BenchmarkCell {
   bool ok = false;
-  std::string error;  ///< why the run failed
+  bool not_built = false;  ///< the variant is a peer this build lacks: not run
+  std::string error;       ///< why the run failed
   RunSummary run;
   AteResult ate;  ///< against the sequence's ground truth (zero without one)
   KittiDriftResult kitti;
@@ -53,7 +58,8 @@ struct BenchmarkCell {
 
 struct BenchmarkSequence {
   std::string name, data_folder;
-  bool still = false;  ///< the ground truth does not move: drift tables instead of ATE
+  std::string reference;  ///< the trajectory file used as ground truth (empty: the source's own)
+  bool still = false;     ///< the ground truth does not move: drift tables instead of ATE
   double path_length = 0.0;
   std::map<std::string, BenchmarkCell> cells;  ///< by variant name
 };
@@ -66,7 +72,8 @@ struct BenchmarkResult {
 };
 
 /// The methods, plus CTF-ICP's ablations when `ablation` and ctf-icp is among them. Throws Error
-/// for an unknown method, before any work.
+/// for an unknown method, before any work; a known peer this build lacks is kept, marked
+/// not_built.
 std::vector<BenchmarkVariant> benchmark_variants(const std::vector<std::string>& methods,
                                                  int threads, bool ablation);
 

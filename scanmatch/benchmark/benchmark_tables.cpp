@@ -25,7 +25,7 @@ std::vector<ResultTable> benchmark_tables(const std::vector<BenchmarkSequence>& 
   const auto cell_text = [](const BenchmarkCell* c,
                             const std::function<std::string(const BenchmarkCell&)>& f) {
     if (!c) return std::string("");
-    return c->ok ? f(*c) : std::string("failed");
+    return c->ok ? f(*c) : std::string(c->not_built ? "not built" : "failed");
   };
   const auto find = [](const BenchmarkSequence& r, const std::string& v) -> const BenchmarkCell* {
     const auto it = r.cells.find(v);
@@ -137,9 +137,36 @@ std::vector<ResultTable> benchmark_tables(const std::vector<BenchmarkSequence>& 
            })});
     }
   tables.push_back(loam);
+  // The summary a reader wants first, one row a method: accuracy and speed next to each other.
+  ResultTable side{"ATE and frames per second side by side",
+                   "ATE RMSE in % of path length, no alignment; frames per second of the "
+                   "pipeline alone.",
+                   {"method"},
+                   {}};
+  for (const auto& r : results)
+    if (!r.still) {
+      side.header.push_back(r.name + " ATE %");
+      side.header.push_back(r.name + " frames/s");
+    }
+  for (const auto& m : methods) {
+    std::vector<std::string> row{m};
+    for (const auto& r : results) {
+      if (r.still) continue;
+      const BenchmarkCell* c = find(r, m);
+      row.push_back(cell_text(c, [](const BenchmarkCell& x) {
+        return percent(x.ate.rmse_percent_of_path) + bridged_note(x);
+      }));
+      row.push_back(cell_text(c, [](const BenchmarkCell& x) {
+        return fmt::format("{:.1f}", x.run.frames_per_second);
+      }));
+    }
+    side.rows.push_back(row);
+  }
+  if (side.header.size() > 1) tables.push_back(side);
   bool any_kitti = false;
   for (const auto& row : kitti.rows)
-    for (std::size_t i = 1; i < row.size(); ++i) any_kitti = any_kitti || row[i] != "-";
+    for (std::size_t i = 1; i < row.size(); ++i)
+      any_kitti = any_kitti || (row[i] != "-" && row[i] != "not built");
   if (any_kitti) tables.push_back(kitti);
   return tables;
 }

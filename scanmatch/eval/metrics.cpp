@@ -127,14 +127,20 @@ AteResult compute_ate(const std::vector<Pose>& ground_truth, const std::vector<P
   return r;
 }
 
-RpeResult compute_rpe_frames(const std::vector<Pose>& ground_truth,
-                             const std::vector<Pose>& estimate, std::size_t delta) {
+RelativeErrors relative_errors(const std::vector<Pose>& ground_truth,
+                               const std::vector<Pose>& estimate, std::size_t delta) {
   check_same_size(ground_truth, estimate, "RPE");
   if (delta == 0) fail("RPE", "frame delta must be at least 1");
-  std::vector<double> translation, rotation;
+  RelativeErrors errors;
   for (std::size_t i = 0; i + delta < ground_truth.size(); ++i)
-    add_relative_error(ground_truth, estimate, i, i + delta, translation, rotation);
-  return summarise_rpe(translation, rotation);
+    add_relative_error(ground_truth, estimate, i, i + delta, errors.translation, errors.rotation);
+  return errors;
+}
+
+RpeResult compute_rpe_frames(const std::vector<Pose>& ground_truth,
+                             const std::vector<Pose>& estimate, std::size_t delta) {
+  const RelativeErrors errors = relative_errors(ground_truth, estimate, delta);
+  return summarise_rpe(errors.translation, errors.rotation);
 }
 
 RpeResult compute_rpe_distance(const std::vector<Pose>& ground_truth,
@@ -202,6 +208,7 @@ Association associate(const Trajectory& ground_truth, const Trajectory& estimate
       out.ground_truth.push_back(ground_truth.poses[j]);
       out.estimate.push_back(estimate.poses[i]);
       out.timestamps.push_back(t);
+      out.estimate_index.push_back(i);
     }
     const std::size_t expected = std::min(ground_truth.size(), estimate.size());
     if (out.estimate.empty())
@@ -226,6 +233,7 @@ Association associate(const Trajectory& ground_truth, const Trajectory& estimate
                           ground_truth.poses.begin() + static_cast<std::ptrdiff_t>(n));
   out.estimate.assign(estimate.poses.begin(),
                       estimate.poses.begin() + static_cast<std::ptrdiff_t>(n));
+  for (std::size_t i = 0; i < n; ++i) out.estimate_index.push_back(i);
   out.description =
       "by index (" + std::to_string(n) + " poses; " +
       (ground_truth.has_timestamps() || estimate.has_timestamps() ? "only one file has timestamps)"

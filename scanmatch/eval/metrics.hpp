@@ -37,6 +37,16 @@ struct RpeResult {
   double translation_rmse = 0, translation_mean = 0, translation_median = 0;  ///< m
   double rotation_rmse = 0, rotation_mean = 0;                                ///< deg
 };
+/// The error of each relative motion between poses `delta` frames apart, in order: entry k is
+/// that of pose k to pose k + delta (`ground_truth.size() - delta` entries). The per-step view of
+/// compute_rpe_frames, for plotting where along a run the error arises.
+struct RelativeErrors {
+  std::vector<double> translation;  ///< m
+  std::vector<double> rotation;     ///< deg
+};
+RelativeErrors relative_errors(const std::vector<Pose>& ground_truth,
+                               const std::vector<Pose>& estimate, std::size_t delta = 1);
+
 /// Relative pose error between poses `delta` frames apart.
 RpeResult compute_rpe_frames(const std::vector<Pose>& ground_truth,
                              const std::vector<Pose>& estimate, std::size_t delta);
@@ -62,6 +72,7 @@ std::vector<double> cumulative_distances(const std::vector<Pose>& poses);
 struct Association {
   std::vector<Pose> ground_truth, estimate;  ///< paired poses
   std::vector<double> timestamps;            ///< of the pairs, when associated by time
+  std::vector<std::size_t> estimate_index;   ///< of each pair in the estimate trajectory
   bool by_timestamp = false;
   std::string description;  ///< e.g. "by index (KITTI files carry no timestamps)"
 };

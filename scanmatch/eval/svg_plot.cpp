@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 namespace scanmatch {
 namespace {
@@ -57,7 +58,8 @@ std::string html_escape(const std::string& text) {
   return out;
 }
 
-std::string svg_plot(const std::vector<SvgSeries>& series, const SvgPlotOptions& o) {
+std::string svg_plot(const std::vector<SvgSeries>& series, const SvgPlotOptions& o,
+                     const SvgAxisRanges& ranges) {
   const double left = 64, right = 16, top = o.title.empty() ? 14 : 34, bottom = 46;
   const double plot_w = o.width - left - right, plot_h = o.height - top - bottom;
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
@@ -70,6 +72,8 @@ std::string svg_plot(const std::vector<SvgSeries>& series, const SvgPlotOptions&
       y1 = std::max(y1, p.y());
     }
   if (!std::isfinite(x0)) x0 = y0 = 0, x1 = y1 = 1;
+  if (ranges.x) std::tie(x0, x1) = *ranges.x;
+  if (ranges.y) std::tie(y0, y1) = *ranges.y;
   if (x1 - x0 < 1e-9) x0 -= 0.5, x1 += 0.5;
   if (y1 - y0 < 1e-9) y0 -= 0.5, y1 += 0.5;
   // 4 % margins, then equal aspect by widening the narrower range.
@@ -148,8 +152,8 @@ std::string svg_plot(const std::vector<SvgSeries>& series, const SvgPlotOptions&
     if (!path.empty())
       svg += fmt::format(
           "<path d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" "
-          "stroke-opacity=\"{}\" stroke-linejoin=\"round\"/>\n",
-          path, s.color, s.line_width, s.opacity);
+          "stroke-opacity=\"{}\" stroke-linejoin=\"round\"{}/>\n",
+          path, s.color, s.line_width, s.opacity, s.dashed ? " stroke-dasharray=\"6,4\"" : "");
   }
   svg += "</g>\n";
   // Legend, top left inside the frame.

@@ -3,6 +3,7 @@
 // series on linear axes with "nice" ticks, a legend and optionally equal aspect (maps, paths).
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,12 +18,19 @@ struct SvgSeries {
   double line_width = 1.5;              ///< px
   double dot_radius = 1.0;              ///< px, scatter only
   double opacity = 1.0;
+  bool dashed = false;  ///< a dashed line (thresholds, references)
 };
 
 struct SvgPlotOptions {
   std::string title, x_label, y_label;
   int width = 640, height = 420;  ///< px
   bool equal_aspect = false;      ///< one data unit is as long on both axes
+};
+
+/// Fixed axis ranges (min, max) instead of the data's, e.g. for plots over the same frames placed
+/// one above the other. A small margin is still added.
+struct SvgAxisRanges {
+  std::optional<std::pair<double, double>> x, y;
 };
 
 /// A line series (a scatter one after setting .scatter).
@@ -36,7 +44,8 @@ inline SvgSeries make_series(std::string label, std::string color,
 }
 
 /// The plot as an inline <svg> element. Empty series are skipped; no data gives an empty frame.
-std::string svg_plot(const std::vector<SvgSeries>& series, const SvgPlotOptions& options);
+std::string svg_plot(const std::vector<SvgSeries>& series, const SvgPlotOptions& options,
+                     const SvgAxisRanges& ranges = {});
 
 /// A qualitative palette colour for series i (cycles).
 std::string palette_color(std::size_t i);

@@ -41,12 +41,24 @@ bool register_odometry_peer(const std::string& name, const std::string& descript
   return true;
 }
 
-void check_odometry_method(const std::string& method) {
-  if (peers().count(method) > 0) return;
+std::vector<std::string> known_odometry_peers() {
+  std::vector<std::string> names;
+  for (const KnownPeer& known : kKnownPeers) names.emplace_back(known.name);
+  return names;
+}
+
+std::string missing_peer_option(const std::string& method) {
+  if (peers().count(method) > 0) return "";
   for (const KnownPeer& known : kKnownPeers)
-    if (method == known.name)
-      throw Error("odometry method '" + method +
-                  "' is a peer this build does not have: configure with " + known.option);
+    if (method == known.name) return known.option;
+  return "";
+}
+
+void check_odometry_method(const std::string& method) {
+  if (const std::string option = missing_peer_option(method); !option.empty())
+    throw Error("odometry method '" + method +
+                "' is a peer this build does not have: configure with " + option);
+  if (peers().count(method) > 0) return;
   if (!is_odometry_method(method))
     throw Error("unknown odometry method '" + method +
                 "' (valid: " + odometry_methods_with_peers() + ")");

@@ -57,4 +57,11 @@ std::vector<std::string> odometry_peers();
 /// odometry_method_list() plus the peers built in.
 std::string odometry_methods_with_peers();
 
+/// Every peer this project knows (built into this program or not), by name.
+std::vector<std::string> known_odometry_peers();
+
+/// For a peer this project knows but this build lacks, the CMake option that builds it; empty
+/// for a peer that is built, for our own methods and for unknown names.
+std::string missing_peer_option(const std::string& method);
+
 }  // namespace scanmatch

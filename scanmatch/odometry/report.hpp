@@ -1,8 +1,11 @@
 #pragma once
 // The HTML report: one self-contained file (inline SVG plots made by svg_plot.hpp, no scripts, no
 // network) comparing run folders of `scanmatch odometry` against a ground truth: a table of
-// accuracy and speed, a top view of every trajectory, position error over distance, per-stage
-// time per frame, and a side view of the map when a run saved one.
+// accuracy and speed, a top view of every trajectory, position error over distance; per run, the
+// error of each step against the reference and the health record over frames (fine paired
+// fraction, uncertain priors, coarse/fine disagreement, with the thresholds of summary.json's
+// `health`) and the worst steps with what the record said there; per-stage time per frame, and a
+// side view of the map when a run saved one.
 
 #include <optional>
 #include <string>

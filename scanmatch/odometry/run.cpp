@@ -16,6 +16,7 @@
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
+#include "scanmatch/odometry/health.hpp"
 
 namespace scanmatch {
 namespace {
@@ -68,11 +69,9 @@ nlohmann::ordered_json health_json(const std::vector<FrameStats>& frames) {
   for (const FrameStats& f : frames) {
     uncertain += f.prior_uncertain;
     recovered += f.recovered;
-    disagreeing += f.coarse_fine_m > 0.25 || f.coarse_fine_deg > 3.0;
-    if (f.fine_paired_fraction > 0.0) {
-      paired.push_back(f.fine_paired_fraction);
-      thin += f.fine_paired_fraction < 0.3;
-    }
+    disagreeing += health::stages_disagree(f);
+    thin += health::thin_map(f);
+    if (f.fine_paired_fraction > 0.0) paired.push_back(f.fine_paired_fraction);
   }
   std::sort(paired.begin(), paired.end());
   return {{"uncertain_priors", uncertain},

@@ -47,6 +47,15 @@ std::unique_ptr<SequenceSource> open_source(const std::string& spec,
 
 }  // namespace
 
+std::string reference_beside(const std::string& spec) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (is_simulator_spec(spec) || !fs::is_directory(spec, ec)) return "";
+  for (const char* name : {"odom_poses.txt", "reference_poses.txt"})
+    if (fs::is_regular_file(fs::path(spec) / name, ec)) return (fs::path(spec) / name).string();
+  return "";
+}
+
 bool is_simulator_spec(const std::string& spec) {
   return spec.rfind("sim:", 0) == 0;
 }

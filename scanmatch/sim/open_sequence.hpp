@@ -37,6 +37,12 @@ struct SequenceOptions {
 std::unique_ptr<SequenceSource> open_sequence(const std::string& spec,
                                               const SequenceOptions& options = {});
 
+/// A reference trajectory kept beside a folder's frames under a name the folder reader does not
+/// take as ground truth itself: FOLDER/odom_poses.txt (as SLAM pipelines save their odometry) or
+/// FOLDER/reference_poses.txt. Its path, or empty when `spec` is not a folder or holds neither.
+/// For SequenceOptions::reference where the source has no ground truth of its own.
+std::string reference_beside(const std::string& spec);
+
 /// True for `sim:PRESET` specs.
 bool is_simulator_spec(const std::string& spec);
 
