@@ -248,6 +248,8 @@ void describe(Map2DRunOptions& o, Visitor& v) {
     "No-return beams free the grid out to this range, m (0: not at all)");
   v("reference_map", o.reference_map, "--reference-map",
     "Also build map_reference.* from the input's reference poses");
+  v("loop_closure", o.loop_closure, "--loop-closure",
+    "2D loop closure: a pose graph over keyframes, verified loops, map.* from optimized poses");
   v.nested("mapper", o.mapper);
   v.nested("grid", o.grid);
 }
