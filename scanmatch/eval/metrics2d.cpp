@@ -66,6 +66,9 @@ AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference
     cross += e.x() * f.y() - e.y() * f.x();
   }
   const Eigen::Rotation2Dd rotation(std::atan2(cross, dot));
+  r.alignment = Pose2::Identity();
+  r.alignment.linear() = rotation.toRotationMatrix();
+  r.alignment.translation() = mean_ref - rotation * mean_est;
   double sum = 0.0, sum_squared = 0.0;
   for (std::size_t i = 0; i < r.poses; ++i) {
     const Eigen::Vector2d aligned = rotation * (estimate[i].translation() - mean_est) + mean_ref;

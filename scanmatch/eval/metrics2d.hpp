@@ -28,7 +28,8 @@ RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
 /// least squares) that best aligns `estimate` onto `reference`.
 struct AbsoluteError2D {
   std::size_t poses = 0;
-  double rmse = 0, mean = 0, max = 0;  ///< m
+  double rmse = 0, mean = 0, max = 0;   ///< m
+  Pose2 alignment = Pose2::Identity();  ///< maps estimated positions onto the reference
 };
 /// Throws Error when the sizes differ; zero error for fewer than two poses.
 AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference,

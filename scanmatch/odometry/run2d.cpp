@@ -40,13 +40,17 @@ nlohmann::ordered_json ate_json(const AbsoluteError2D& e) {
   return {{"poses", e.poses}, {"rmse_m", e.rmse}, {"mean_m", e.mean}, {"max_m", e.max}};
 }
 
-// Share of `map`'s occupied cells with an occupied cell of `reference` within `cells` cells.
-double map_agreement(const OccupancyGrid& map, const OccupancyGrid& reference, int cells) {
+// Share of `map`'s occupied cells, moved by `alignment` (the trajectory's SE(2) alignment onto
+// the reference, so that an early heading error does not count everywhere), with an occupied cell
+// of `reference` within `cells` cells.
+double map_agreement(const OccupancyGrid& map, const OccupancyGrid& reference, int cells,
+                     const Pose2& alignment) {
   const std::vector<Eigen::Vector2d> occupied = map.occupied_cell_centres();
   if (occupied.empty()) return 0.0;
   const double r = reference.resolution();
   std::size_t near = 0;
-  for (const Eigen::Vector2d& c : occupied) {
+  for (const Eigen::Vector2d& cell : occupied) {
+    const Eigen::Vector2d c = alignment * cell;
     bool found = false;
     for (int dx = -cells; dx <= cells && !found; ++dx)
       for (int dy = -cells; dy <= cells && !found; ++dy)
@@ -237,7 +241,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     grid.crop_to_observed();
     write_map(grid, file(loop_closure ? "map_odometry" : "map"));
     if (reference_written) {
-      const double agreement = map_agreement(grid, reference_grid, 2);
+      const double agreement = map_agreement(
+          grid, reference_grid, 2, reference.front().inverse() * summary.ate_odometry.alignment);
       (loop_closure ? summary.map_agreement_odometry : summary.map_agreement) = agreement;
     }
   }
@@ -246,7 +251,9 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       optimized_grid.crop_to_observed();
       write_map(optimized_grid, file("map"));
       if (reference_written)
-        summary.map_agreement = map_agreement(optimized_grid, reference_grid, 2);
+        summary.map_agreement =
+            map_agreement(optimized_grid, reference_grid, 2,
+                          reference.front().inverse() * summary.ate_optimized.alignment);
     } else {
       summary.map_error = optimized_map_error;
     }
