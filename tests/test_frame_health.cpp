@@ -92,13 +92,28 @@ struct Tracked {
   std::size_t recoveries = 0;
 };
 
-Tracked track(const std::vector<PointCloud>& frames, const std::vector<double>& times,
-              const std::vector<Pose>& truth, const OdometryConfig& config) {
+struct Frames {
+  std::vector<PointCloud> clouds;
+  std::vector<double> times;
+};
+
+// Every frame of `simulator`, thinned like a keyframe folder when `thin` is given.
+Frames frames_of(const sim::Simulator& simulator, const sim::KeyframeOptions* thin = nullptr) {
+  Frames f;
+  for (std::size_t i = 0; i < simulator.size(); ++i) {
+    f.clouds.push_back(thin ? sim::thin_keyframe(simulator.frame(i), *thin, i)
+                            : simulator.frame(i));
+    f.times.push_back(simulator.frame_time(i));
+  }
+  return f;
+}
+
+Tracked track(const Frames& frames, const std::vector<Pose>& truth, const OdometryConfig& config) {
   Odometry odometry(config);
   Tracked t;
   std::vector<Pose> poses;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    poses.push_back(odometry.register_frame(frames[i], times[i]));
+  for (std::size_t i = 0; i < frames.clouds.size(); ++i) {
+    poses.push_back(odometry.register_frame(frames.clouds[i], frames.times[i]));
     t.recoveries += odometry.last_stats().recovered;
   }
   t.ate = compute_ate({truth.begin(), truth.begin() + static_cast<std::ptrdiff_t>(poses.size())},
@@ -123,16 +138,15 @@ TEST(RecordedAvia, KeyframesAreTrackedBelowTwoPercentWithDefaults) {
   // LiDAR-inertial poses are the reference. Measured 0.24 % (5.28 % before the turned starts;
   // KISS-ICP 9.18 %).
   auto source = open_sequence_folder(folder + "/frames");
-  std::vector<PointCloud> frames;
-  std::vector<double> times;
+  Frames frames;
   Frame frame;
   while (source->next(frame)) {
-    frames.push_back(frame.cloud);
-    times.push_back(frame.timestamp);
+    frames.clouds.push_back(frame.cloud);
+    frames.times.push_back(frame.timestamp);
   }
   const Trajectory reference = read_trajectory(folder + "/odom_poses.txt");
-  ASSERT_EQ(reference.size(), frames.size());
-  const Tracked tracked = track(frames, times, reference.poses, OdometryConfig{});
+  ASSERT_EQ(reference.size(), frames.clouds.size());
+  const Tracked tracked = track(frames, reference.poses, OdometryConfig{});
   EXPECT_LT(tracked.ate.rmse_percent_of_path, 2.0);
   EXPECT_GT(tracked.recoveries, 0u);  // the record says which frames another start rescued
 }
@@ -154,15 +168,10 @@ TEST(RecordedAvia, ItsMotionReplayedInTheSimulatorFailsAlikeAndIsTrackedAfterThe
   sim::KeyframeOptions thin;
   thin.max_points = 5000;
   thin.point_time = false;
-  std::vector<PointCloud> frames;
-  std::vector<double> times;
-  for (std::size_t i = 0; i < simulator.size(); ++i) {
-    frames.push_back(sim::thin_keyframe(simulator.frame(i), thin, i));
-    times.push_back(simulator.frame_time(i));
-  }
+  const Frames frames = frames_of(simulator, &thin);
   const std::vector<Pose>& truth = simulator.ground_truth().poses;
-  const Tracked fixed = track(frames, times, truth, OdometryConfig{});
-  const Tracked before = track(frames, times, truth, without_turned_starts());
+  const Tracked fixed = track(frames, truth, OdometryConfig{});
+  const Tracked before = track(frames, truth, without_turned_starts());
   // Measured 3.0 % against 7.0 % (gicp 12.6 %); what is left are views of one wall.
   EXPECT_LT(fixed.ate.rmse_percent_of_path, 4.0);
   EXPECT_GT(before.ate.rmse_percent_of_path, 1.5 * fixed.ate.rmse_percent_of_path);
@@ -175,12 +184,7 @@ TEST(HandHeld, FastTurnsInTheOfficeAreTrackedWithTurnedStarts) {
   o.preset = "handheld-fast";
   o.frames = 200;
   const sim::Simulator simulator(o);
-  std::vector<PointCloud> frames;
-  std::vector<double> times;
-  for (std::size_t i = 0; i < simulator.size(); ++i) {
-    frames.push_back(simulator.frame(i));
-    times.push_back(simulator.frame_time(i));
-  }
-  const Tracked tracked = track(frames, times, simulator.ground_truth().poses, OdometryConfig{});
+  const Tracked tracked =
+      track(frames_of(simulator), simulator.ground_truth().poses, OdometryConfig{});
   EXPECT_LT(tracked.ate.rmse_percent_of_path, 3.0);  // measured 1.6 %
 }
