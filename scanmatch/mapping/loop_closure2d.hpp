@@ -28,7 +28,8 @@ struct LoopVerification2DOptions {
   /// Correlative search around the candidate's implied relative pose: +- m in x and y, +- rad.
   double search_window = 2.0;
   double search_angle = 30.0 * M_PI / 180;
-  double search_resolution = 0.05;           ///< m
+  /// m; 0.1 found the same loops on the CARMEN logs as 0.05, 3.6x faster (the fine stage refines).
+  double search_resolution = 0.1;
   double max_correspondence_distance = 0.3;  ///< m, of the fine stage
   /// A current point is paired when a candidate point lies within this distance after the
   /// registration, m.

@@ -41,7 +41,7 @@ struct Map2DRunOptions {
   /// 2D loop closure (mapping/loop_closure2d.hpp) over the odometry: poses_optimized_tum.txt,
   /// loops.json, map.* from the optimized poses (the odometry's map becomes map_odometry.*).
   bool loop_closure = false;
-  LoopClosure2DOptions loop;  ///< its settings (library only; not in config.json)
+  LoopClosure2DOptions loop;  ///< its settings (config.json's "loop")
   bool quiet = false;
   const std::atomic<bool>* stop = nullptr;  ///< set to end early (Ctrl-C); what is done is kept
 };
