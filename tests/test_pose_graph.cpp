@@ -254,11 +254,11 @@ TEST(PoseGraph2D, WrongLoopIsRejectedAndTheKernelMatters) {
 }
 
 TEST(PoseGraph2D, OdometryKernelLetsLoopsOverruleAFailedScanMatch) {
-  // A scan match that converged 1 m and 10 degrees off between nodes 49 and 50 (as a second
+  // A scan match that converged 2 m and 20 degrees off between nodes 49 and 50 (as a second
   // odometry edge beside the true one, so that the graph stays connected either way).
   auto with_failed_match = [](const PoseGraphConfig& config) {
     Square2D square(kSquareNodes, kTrueLoops, config);
-    const Pose2 failed = square.truth[49].inverse() * square.truth[50] * pose2(1.0, 0.0, 0.17);
+    const Pose2 failed = square.truth[49].inverse() * square.truth[50] * pose2(2.0, 0.0, 0.35);
     square.graph.add_edge(49, 50, failed, information2d(kOdometrySigmaXY, kOdometrySigmaTheta),
                           EdgeKind::kOdometry);
     square.graph.optimize();
