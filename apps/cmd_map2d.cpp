@@ -106,6 +106,24 @@ void add_map2d_command(CLI::App& app) {
               "{:.2f} deg, failures {:.1f} %\n",
               e->step, 1000 * e->mean_translation, e->mean_rotation * 180 / M_PI,
               1000 * e->median_translation, e->median_rotation * 180 / M_PI, 100 * e->failure_rate);
+      if (s.ate_odometry.poses > 0)
+        fmt::print("ATE (SE(2)-aligned) of the odometry: rmse {:.3f} m, max {:.3f} m\n",
+                   s.ate_odometry.rmse, s.ate_odometry.max);
+      if (s.loop_closure) {
+        fmt::print(
+            "loop closure: {} keyframes, {} candidates, {} verified, {} accepted ({} outliers), "
+            "{:.2f} ms per scan\n",
+            s.loops.keyframes, s.loops.candidates, s.loops.verified, s.accepted_loops,
+            s.loops.outliers, s.loop_ms_per_scan);
+        if (s.ate_optimized.poses > 0)
+          fmt::print("ATE (SE(2)-aligned) loop-closed: rmse {:.3f} m, max {:.3f} m\n",
+                     s.ate_optimized.rmse, s.ate_optimized.max);
+      }
+      if (s.map_agreement >= 0)
+        fmt::print("map agreement with map_reference (2 cells): {:.3f}{}\n", s.map_agreement,
+                   s.map_agreement_odometry >= 0
+                       ? fmt::format(" (odometry map {:.3f})", s.map_agreement_odometry)
+                       : "");
       if (!s.map_error.empty()) fmt::print("no map written: {}\n", s.map_error);
       fmt::print("run folder: {}\n", c->out);
     }

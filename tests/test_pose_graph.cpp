@@ -253,6 +253,32 @@ TEST(PoseGraph2D, WrongLoopIsRejectedAndTheKernelMatters) {
   EXPECT_GT(plain_error, 5 * kernel_error);
 }
 
+TEST(PoseGraph2D, OdometryKernelLetsLoopsOverruleAFailedScanMatch) {
+  // A scan match that converged 2 m and 20 degrees off between nodes 49 and 50 (as a second
+  // odometry edge beside the true one, so that the graph stays connected either way).
+  auto with_failed_match = [](const PoseGraphConfig& config) {
+    Square2D square(kSquareNodes, kTrueLoops, config);
+    const Pose2 failed = square.truth[49].inverse() * square.truth[50] * pose2(2.0, 0.0, 0.35);
+    square.graph.add_edge(49, 50, failed, information2d(kOdometrySigmaXY, kOdometrySigmaTheta),
+                          EdgeKind::kOdometry);
+    square.graph.optimize();
+    return max_position_error(square.graph.poses(), square.truth);
+  };
+  Square2D clean(kSquareNodes, kTrueLoops, PoseGraphConfig{});
+  clean.graph.optimize();
+  const double clean_error = max_position_error(clean.graph.poses(), clean.truth);
+  PoseGraphConfig robust;
+  robust.odometry_kernel = LoopKernel::kCauchy;
+  const double trusted = with_failed_match(PoseGraphConfig{});
+  const double overruled = with_failed_match(robust);
+  std::printf(
+      "2D failed scan match: max position error %.3f m clean, %.3f m trusted, %.3f m "
+      "with the odometry kernel\n",
+      clean_error, trusted, overruled);
+  EXPECT_GT(trusted, 0.3);
+  EXPECT_LT(overruled, clean_error + 0.05);
+}
+
 TEST(PoseGraph3D, LoopWithRotationNoiseCutsDriftFiveFold) {
   Square3D square(kSquareNodes, kTrueLoops, PoseGraphConfig{});
   const double drift = max_position_error(square.odometry, square.truth);

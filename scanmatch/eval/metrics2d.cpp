@@ -41,4 +41,45 @@ RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
   return r;
 }
 
+AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference,
+                                             const std::vector<Pose2>& estimate) {
+  if (reference.size() != estimate.size())
+    throw Error("absolute trajectory error: " + std::to_string(estimate.size()) +
+                " estimated poses against " + std::to_string(reference.size()) +
+                " reference poses");
+  AbsoluteError2D r;
+  r.poses = reference.size();
+  if (r.poses < 2) return r;
+  Eigen::Vector2d mean_ref = Eigen::Vector2d::Zero(), mean_est = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < r.poses; ++i) {
+    mean_ref += reference[i].translation();
+    mean_est += estimate[i].translation();
+  }
+  mean_ref /= static_cast<double>(r.poses);
+  mean_est /= static_cast<double>(r.poses);
+  // The rotation angle that best turns the centred estimate onto the centred reference.
+  double dot = 0.0, cross = 0.0;
+  for (std::size_t i = 0; i < r.poses; ++i) {
+    const Eigen::Vector2d e = estimate[i].translation() - mean_est;
+    const Eigen::Vector2d f = reference[i].translation() - mean_ref;
+    dot += e.dot(f);
+    cross += e.x() * f.y() - e.y() * f.x();
+  }
+  const Eigen::Rotation2Dd rotation(std::atan2(cross, dot));
+  r.alignment = Pose2::Identity();
+  r.alignment.linear() = rotation.toRotationMatrix();
+  r.alignment.translation() = mean_ref - rotation * mean_est;
+  double sum = 0.0, sum_squared = 0.0;
+  for (std::size_t i = 0; i < r.poses; ++i) {
+    const Eigen::Vector2d aligned = rotation * (estimate[i].translation() - mean_est) + mean_ref;
+    const double d = (aligned - reference[i].translation()).norm();
+    sum += d;
+    sum_squared += d * d;
+    r.max = std::max(r.max, d);
+  }
+  r.mean = sum / static_cast<double>(r.poses);
+  r.rmse = std::sqrt(sum_squared / static_cast<double>(r.poses));
+  return r;
+}
+
 }  // namespace scanmatch

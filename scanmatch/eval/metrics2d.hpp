@@ -24,4 +24,15 @@ RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
                                        double failure_translation = 0.2,
                                        double failure_rotation = 5.0 * M_PI / 180);
 
+/// Absolute trajectory error of positions after the rigid 2D motion (rotation and translation,
+/// least squares) that best aligns `estimate` onto `reference`.
+struct AbsoluteError2D {
+  std::size_t poses = 0;
+  double rmse = 0, mean = 0, max = 0;   ///< m
+  Pose2 alignment = Pose2::Identity();  ///< maps estimated positions onto the reference
+};
+/// Throws Error when the sizes differ; zero error for fewer than two poses.
+AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference,
+                                             const std::vector<Pose2>& estimate);
+
 }  // namespace scanmatch

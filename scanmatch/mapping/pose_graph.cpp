@@ -158,12 +158,12 @@ int iterations(const ceres::Solver::Summary& summary) {
   return summary.num_successful_steps + summary.num_unsuccessful_steps;
 }
 
-std::unique_ptr<ceres::LossFunction> make_loop_loss(const PoseGraphConfig& config) {
-  switch (config.loop_kernel) {
+std::unique_ptr<ceres::LossFunction> make_loss(LoopKernel kernel, double scale) {
+  switch (kernel) {
     case LoopKernel::kHuber:
-      return std::make_unique<ceres::HuberLoss>(config.loop_kernel_scale);
+      return std::make_unique<ceres::HuberLoss>(scale);
     case LoopKernel::kCauchy:
-      return std::make_unique<ceres::CauchyLoss>(config.loop_kernel_scale);
+      return std::make_unique<ceres::CauchyLoss>(scale);
     case LoopKernel::kNone:
       break;
   }
@@ -182,7 +182,10 @@ bool solve(const PoseGraphConfig& config, const std::vector<typename PoseGraph<D
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  const std::unique_ptr<ceres::LossFunction> loop_loss = make_loop_loss(config);
+  const std::unique_ptr<ceres::LossFunction> loop_loss =
+      make_loss(config.loop_kernel, config.loop_kernel_scale);
+  const std::unique_ptr<ceres::LossFunction> odometry_loss =
+      make_loss(config.odometry_kernel, config.odometry_kernel_scale);
   ceres::EigenQuaternionManifold quaternion_manifold;
 
   // Blocks only for nodes an edge touches: Ceres needs every block in a residual.
@@ -207,7 +210,8 @@ bool solve(const PoseGraphConfig& config, const std::vector<typename PoseGraph<D
     const auto& edge = edges[i];
     add_node(edge.from);
     add_node(edge.to);
-    ceres::LossFunction* loss = edge.kind == EdgeKind::kLoop ? loop_loss.get() : nullptr;
+    ceres::LossFunction* loss =
+        edge.kind == EdgeKind::kLoop ? loop_loss.get() : odometry_loss.get();
     const auto residual = L::residual(edge, whitening(edge.information));
     double* from = params[edge.from].data();
     double* to = params[edge.to].data();

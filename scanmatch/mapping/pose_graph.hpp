@@ -50,6 +50,10 @@ struct PoseGraphConfig {
   /// sigmas off on a 0.5 m drift stayed open (a local minimum) and were judged outliers. A wrong
   /// loop 700 sigmas off pulls with ~0.1 sigma at 10, and is then dropped by the chi-square test.
   double loop_kernel_scale = 10.0;
+  /// Odometry edges may get a kernel too: a scan match that converged to a wrong pose is then an
+  /// edge that verified loops on both sides of it can overrule (kNone: odometry is trusted).
+  LoopKernel odometry_kernel = LoopKernel::kNone;
+  double odometry_kernel_scale = 10.0;
   /// A loop edge whose chi-square r^T I r exceeds this after the solve is an outlier. Defaults are
   /// the 99.9 % quantiles of chi-square with 3 (2D) and 6 (3D) degrees of freedom.
   double outlier_chi2_2d = 16.27;

@@ -13,6 +13,7 @@
 // field whose flag starts with "--no-" is switched off by it (`--no-fine`: fine_stage = false);
 // any other bool flag switches its field on.
 
+#include "scanmatch/core/error.hpp"
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/odometry.hpp"
 #include "scanmatch/odometry/run2d.hpp"
@@ -30,6 +31,27 @@ inline const char* enum_name(PathRules::Shared shared) {
 }
 inline void enum_from_name(const std::string& name, PathRules::Shared& shared) {
   shared = parse_shared_rows(name);
+}
+inline const char* enum_name(LoopKernel kernel) {
+  switch (kernel) {
+    case LoopKernel::kNone:
+      return "none";
+    case LoopKernel::kHuber:
+      return "huber";
+    case LoopKernel::kCauchy:
+      return "cauchy";
+  }
+  return "none";
+}
+inline void enum_from_name(const std::string& name, LoopKernel& kernel) {
+  if (name == "none")
+    kernel = LoopKernel::kNone;
+  else if (name == "huber")
+    kernel = LoopKernel::kHuber;
+  else if (name == "cauchy")
+    kernel = LoopKernel::kCauchy;
+  else
+    throw Error("unknown pose graph kernel '" + name + "' (none, huber, cauchy)");
 }
 
 template <typename Visitor>
@@ -243,11 +265,79 @@ void describe(GridMapOptions& g, Visitor& v) {
 }
 
 template <typename Visitor>
+void describe(PoseGraphConfig& g, Visitor& v) {
+  v("loop_kernel", g.loop_kernel, nullptr, "Robust kernel of loop edges: none, huber, cauchy");
+  v("loop_kernel_scale", g.loop_kernel_scale, nullptr,
+    "Where the loop kernel starts, in standard deviations");
+  v("odometry_kernel", g.odometry_kernel, nullptr,
+    "Robust kernel of odometry edges: none, huber, cauchy");
+  v("odometry_kernel_scale", g.odometry_kernel_scale, nullptr,
+    "Where the odometry kernel starts, in standard deviations");
+  v("outlier_chi2_2d", g.outlier_chi2_2d, nullptr,
+    "Chi-square above which a 2D loop is an outlier");
+  v("outlier_chi2_3d", g.outlier_chi2_3d, nullptr,
+    "Chi-square above which a 3D loop is an outlier");
+  v("drop_outliers", g.drop_outliers, nullptr, "Re-solve without the outlier loops");
+  v("max_iterations", g.max_iterations, nullptr, "Levenberg-Marquardt iterations per solve");
+}
+
+template <typename Visitor>
+void describe(LoopVerification2DOptions& o, Visitor& v) {
+  v("method", o.method, nullptr, "Registration method of the verification's fine stage");
+  v("search_window", o.search_window, nullptr, "Correlative search, +- m around the candidate");
+  v("search_angle", o.search_angle, nullptr, "Correlative search, +- rad");
+  v("search_resolution", o.search_resolution, nullptr, "Correlative search cell size, m");
+  v("max_correspondence_distance", o.max_correspondence_distance, nullptr,
+    "Fine stage's correspondence distance, m");
+  v("pair_distance", o.pair_distance, nullptr, "A point is paired within this distance, m");
+  v("min_paired_fraction", o.min_paired_fraction, nullptr,
+    "Share of each scan's points that must be paired");
+  v("max_error", o.max_error, nullptr, "Mean distance of the paired points, at most, m");
+  v("free_margin", o.free_margin, nullptr,
+    "A point this far (m) in front of the other scan's return lies in its free space");
+  v("max_free_violations", o.max_free_violations, nullptr,
+    "Share of points in the other scan's free space, at most");
+  v("min_constraint", o.min_constraint, nullptr,
+    "The weaker direction's share of the paired normals, at least (corridors fail)");
+  v("min_points", o.min_points, nullptr, "Points each scan needs to be verified");
+}
+
+template <typename Visitor>
+void describe(LoopClosure2DOptions& o, Visitor& v) {
+  v("keyframe_distance", o.keyframe_distance, nullptr, "New loop keyframe after this many m");
+  v("keyframe_angle", o.keyframe_angle, nullptr, "New loop keyframe after this many rad");
+  v("odometry_sigma_xy", o.odometry_sigma_xy, nullptr, "Odometry edge standard deviation, m");
+  v("odometry_sigma_theta", o.odometry_sigma_theta, nullptr,
+    "Odometry edge standard deviation, rad");
+  v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
+  v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
+  v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
+  v("proximity_radius", o.proximity_radius, nullptr,
+    "Candidates within this distance in the current estimate, m");
+  v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
+    "Pose-proximity candidates per keyframe, at most");
+  v("max_descriptor_distance", o.max_descriptor_distance, nullptr,
+    "Place-database candidates below this descriptor distance");
+  v("max_descriptor_candidates", o.max_descriptor_candidates, nullptr,
+    "Place-database candidates per keyframe, at most");
+  v("max_correction", o.max_correction, nullptr,
+    "A verified loop may move the estimate by this many m ...");
+  v("max_correction_per_m", o.max_correction_per_m, nullptr,
+    "... plus this share of the path between the two keyframes");
+  v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
+  v.nested("verification", o.verification);
+  v.nested("graph", o.graph);
+}
+
+template <typename Visitor>
 void describe(Map2DRunOptions& o, Visitor& v) {
   v("miss_range", o.miss_range, "--miss-range",
     "No-return beams free the grid out to this range, m (0: not at all)");
   v("reference_map", o.reference_map, "--reference-map",
     "Also build map_reference.* from the input's reference poses");
+  v("loop_closure", o.loop_closure, "--loop-closure",
+    "2D loop closure: a pose graph over keyframes, verified loops, map.* from optimized poses");
+  v.nested("loop", o.loop);
   v.nested("mapper", o.mapper);
   v.nested("grid", o.grid);
 }

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
@@ -33,6 +34,35 @@ nlohmann::ordered_json error_json(const RelativeError2D& e) {
           {"mean_rotation_deg", e.mean_rotation * 180 / M_PI},
           {"median_rotation_deg", e.median_rotation * 180 / M_PI},
           {"failure_rate", e.failure_rate}};
+}
+
+nlohmann::ordered_json ate_json(const AbsoluteError2D& e) {
+  return {{"poses", e.poses}, {"rmse_m", e.rmse}, {"mean_m", e.mean}, {"max_m", e.max}};
+}
+
+// Share of `map`'s occupied cells, moved by `alignment` (the trajectory's SE(2) alignment onto
+// the reference, so that an early heading error does not count everywhere), with an occupied cell
+// of `reference` within `cells` cells.
+double map_agreement(const OccupancyGrid& map, const OccupancyGrid& reference, int cells,
+                     const Pose2& alignment) {
+  const std::vector<Eigen::Vector2d> occupied = map.occupied_cell_centres();
+  if (occupied.empty()) return 0.0;
+  const double r = reference.resolution();
+  std::size_t near = 0;
+  for (const Eigen::Vector2d& cell : occupied) {
+    const Eigen::Vector2d c = alignment * cell;
+    bool found = false;
+    for (int dx = -cells; dx <= cells && !found; ++dx)
+      for (int dy = -cells; dy <= cells && !found; ++dy)
+        found = reference.occupied(c + Eigen::Vector2d(dx * r, dy * r));
+    near += found;
+  }
+  return static_cast<double>(near) / static_cast<double>(occupied.size());
+}
+
+void write_map(const OccupancyGrid& grid, const std::string& base) {
+  grid.write_map_server(base + ".pgm");
+  grid.write_png(base + ".png");
 }
 
 }  // namespace
@@ -90,6 +120,11 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
+  summary.loop_closure = options.loop_closure;
+  std::optional<LoopClosure2D> loop_closure;
+  if (options.loop_closure) loop_closure.emplace(options.loop);
+  // The registered scans, kept to rebuild the map from the optimized poses.
+  std::vector<Scan2D> kept_scans;
   std::vector<Pose2> estimate, reference;
   Trajectory reference_trajectory;
   ProgressReporter progress("map2d", input.scans.size(), "scans", options.quiet);
@@ -125,6 +160,13 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       }
     };
     insert(grid, summary.map_error, pose);
+    if (loop_closure) {
+      loop_closure->add_scan(mapper.last_scan(), pose);
+      Scan2D kept = mapper.last_scan();
+      kept.misses = scan.misses;
+      kept.times.clear();
+      kept_scans.push_back(std::move(kept));
+    }
     if (options.reference_map && input.has_reference)
       insert(reference_grid, summary.reference_map_error,
              reference.front().inverse() * reference.back());
@@ -141,21 +183,80 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     summary.mean_ms = total_ms / static_cast<double>(summary.scans - 1);
     summary.scans_per_second = 1000.0 / std::max(summary.mean_ms, 1e-9);
   }
+  // Loop closure: the optimized poses, their map and the accepted loops.
+  std::vector<Pose2> optimized;
+  OccupancyGrid optimized_grid(options.grid);
+  std::string optimized_map_error;
+  nlohmann::ordered_json loops_json = nlohmann::ordered_json::array();
+  if (loop_closure) {
+    loop_closure->finish();
+    optimized = loop_closure->poses();
+    summary.loops = loop_closure->counts();
+    if (summary.scans > 0)
+      summary.loop_ms_per_scan = summary.loops.total_ms / static_cast<double>(summary.scans);
+    Trajectory optimized_trajectory;
+    for (std::size_t i = 0; i < optimized.size(); ++i) {
+      optimized_trajectory.poses.push_back(to_pose3(optimized[i]));
+      optimized_trajectory.timestamps.push_back(input.scans[i].timestamp);
+      try {
+        if (optimized_map_error.empty())
+          optimized_grid.insert_scan(optimized[i], kept_scans[i].points, kept_scans[i].misses);
+      } catch (const Error& e) {
+        optimized_map_error = e.what();
+      }
+    }
+    const std::string tum = file("poses_optimized_tum.txt");
+    write_trajectory(tum + ".tmp", optimized_trajectory, TrajectoryFormat::kTum);
+    fs::rename(tum + ".tmp", tum);
+    for (const Loop2D& l : loop_closure->loops()) {
+      summary.accepted_loops += !l.outlier;
+      if (l.outlier) continue;
+      loops_json.push_back({{"from", l.from_scan},
+                            {"to", l.to_scan},
+                            {"from_keyframe", l.from_keyframe},
+                            {"to_keyframe", l.to_keyframe},
+                            {"x", l.relative.translation().x()},
+                            {"y", l.relative.translation().y()},
+                            {"theta", pose2_angle(l.relative)},
+                            {"paired_fraction", l.paired_fraction},
+                            {"error_m", l.error}});
+    }
+    write_file_atomic(file("loops.json"), loops_json.dump(2) + "\n");
+  }
   if (input.has_reference && !reference_trajectory.poses.empty()) {
     write_trajectory(file("poses_reference_tum.txt"), reference_trajectory, TrajectoryFormat::kTum);
     if (summary.scans > 1) summary.one_step = relative_pose_error_2d(reference, estimate, 1);
     if (summary.scans > 10) summary.ten_steps = relative_pose_error_2d(reference, estimate, 10);
+    summary.ate_odometry = absolute_trajectory_error_2d(reference, estimate);
+    if (loop_closure) summary.ate_optimized = absolute_trajectory_error_2d(reference, optimized);
   }
+  const bool reference_written = summary.scans > 0 && options.reference_map &&
+                                 input.has_reference && summary.reference_map_error.empty();
+  if (reference_written) {
+    reference_grid.crop_to_observed();
+    write_map(reference_grid, file("map_reference"));
+  }
+  // map.* is the best map there is: the optimized one with loop closure, else the odometry's.
   if (summary.scans > 0 && summary.map_error.empty()) {
     grid.crop_to_observed();
-    grid.write_map_server(file("map.pgm"));
-    grid.write_png(file("map.png"));
+    write_map(grid, file(loop_closure ? "map_odometry" : "map"));
+    if (reference_written) {
+      const double agreement = map_agreement(
+          grid, reference_grid, 2, reference.front().inverse() * summary.ate_odometry.alignment);
+      (loop_closure ? summary.map_agreement_odometry : summary.map_agreement) = agreement;
+    }
   }
-  if (summary.scans > 0 && options.reference_map && input.has_reference &&
-      summary.reference_map_error.empty()) {
-    reference_grid.crop_to_observed();
-    reference_grid.write_map_server(file("map_reference.pgm"));
-    reference_grid.write_png(file("map_reference.png"));
+  if (loop_closure && summary.scans > 0) {
+    if (optimized_map_error.empty()) {
+      optimized_grid.crop_to_observed();
+      write_map(optimized_grid, file("map"));
+      if (reference_written)
+        summary.map_agreement =
+            map_agreement(optimized_grid, reference_grid, 2,
+                          reference.front().inverse() * summary.ate_optimized.alignment);
+    } else {
+      summary.map_error = optimized_map_error;
+    }
   }
   const Registration2DOptions& r = options.mapper.registration;
   nlohmann::ordered_json j;
@@ -192,6 +293,26 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   if (!summary.map_error.empty()) j["map_error"] = summary.map_error;
   if (summary.one_step.pairs > 0) j["relative_error_1"] = error_json(summary.one_step);
   if (summary.ten_steps.pairs > 0) j["relative_error_10"] = error_json(summary.ten_steps);
+  if (summary.ate_odometry.poses > 0) {
+    j["ate"] = ate_json(summary.loop_closure ? summary.ate_optimized : summary.ate_odometry);
+    j["ate_odometry"] = ate_json(summary.ate_odometry);
+  }
+  if (summary.map_agreement >= 0) j["map_agreement"] = summary.map_agreement;
+  if (summary.map_agreement_odometry >= 0)
+    j["map_agreement_odometry"] = summary.map_agreement_odometry;
+  if (summary.loop_closure) {
+    const LoopClosure2DCounts& c = summary.loops;
+    j["loop_closure"] = {{"keyframes", c.keyframes},
+                         {"candidates", c.candidates},
+                         {"verified", c.verified},
+                         {"rejected_by_verification", c.rejected_by_verification},
+                         {"rejected_by_estimate", c.rejected_by_estimate},
+                         {"rejected_as_outliers", c.outliers},
+                         {"accepted", summary.accepted_loops},
+                         {"optimizations", c.optimizations},
+                         {"total_ms", c.total_ms},
+                         {"ms_per_scan", summary.loop_ms_per_scan}};
+  }
   write_file_atomic(file("summary.json"), j.dump(2) + "\n");
   write_file_atomic(file("config.json"), map2d_config_to_json(options));
   return summary;

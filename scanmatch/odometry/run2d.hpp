@@ -8,6 +8,7 @@
 
 #include "scanmatch/eval/metrics2d.hpp"
 #include "scanmatch/io/carmen.hpp"
+#include "scanmatch/mapping/loop_closure2d.hpp"
 #include "scanmatch/odometry/grid_map.hpp"
 #include "scanmatch/odometry/mapper2d.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
@@ -37,6 +38,10 @@ struct Map2DRunOptions {
   /// like a no-return beam, and its free ray would cut through the wall it missed).
   double miss_range = 0.0;
   bool reference_map = false;  ///< also map_reference.{pgm,yaml,png} from the reference poses
+  /// 2D loop closure (mapping/loop_closure2d.hpp) over the odometry: poses_optimized_tum.txt,
+  /// loops.json, map.* from the optimized poses (the odometry's map becomes map_odometry.*).
+  bool loop_closure = false;
+  LoopClosure2DOptions loop;  ///< its settings (config.json's "loop")
   bool quiet = false;
   const std::atomic<bool>* stop = nullptr;  ///< set to end early (Ctrl-C); what is done is kept
 };
@@ -46,13 +51,25 @@ struct Map2DSummary {
   double mean_ms = 0, max_ms = 0, scans_per_second = 0;
   bool interrupted = false, has_reference = false;
   RelativeError2D one_step, ten_steps;
+  /// SE(2)-aligned absolute error against the reference: of the odometry, and of the optimized
+  /// poses when loop closure ran.
+  AbsoluteError2D ate_odometry, ate_optimized;
+  bool loop_closure = false;
+  LoopClosure2DCounts loops;
+  std::size_t accepted_loops = 0;  ///< verified loop edges not judged outliers at the end
+  double loop_ms_per_scan = 0;     ///< wall time loop closure added per scan
+  /// Share of the map's occupied cells within two cells of an occupied cell of map_reference
+  /// (negative: not computed; needs reference_map), for map.* and (with loop closure) the
+  /// odometry's map.
+  double map_agreement = -1, map_agreement_odometry = -1;
   /// Why map.* (or map_reference.*) was not written, e.g. a trajectory too large for the grid.
   std::string map_error, reference_map_error;
 };
 
 /// Writes RUNDIR/poses_tum.txt and timing.csv (flushed per scan), poses_reference_tum.txt,
 /// summary.json, config.json (the options, for `map2d --config`) and map.{pgm,yaml,png}
-/// (atomically).
+/// (atomically); with loop_closure also poses_optimized_tum.txt, loops.json and
+/// map_odometry.{pgm,yaml,png}.
 Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
                        const Map2DRunOptions& options);
 

@@ -193,8 +193,9 @@ Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const P
       for (int tx = cand.bx; tx < std::min(cand.bx + kBlock, span); ++tx) {
         float score = 0.0f;
         for (const auto& [x, y] : c) score += g.at(g.fine, x + tx, y + ty);
+        if (score < best) continue;
         const double offset = std::hypot(tx - half, ty - half) + std::abs(cand.angle);
-        if (score > best || (score == best && offset < best_offset)) {
+        if (score > best || offset < best_offset) {
           best = score;
           best_offset = offset;
           best_a = cand.angle;

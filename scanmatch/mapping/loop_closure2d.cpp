@@ -1,0 +1,348 @@
+#include "scanmatch/mapping/loop_closure2d.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <utility>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/registration/planar/registration2d.hpp"
+
+namespace scanmatch {
+namespace {
+
+bool finite_scan(const Scan2D& scan) {
+  return std::all_of(scan.points.begin(), scan.points.end(),
+                     [](const Eigen::Vector2d& p) { return p.allFinite(); });
+}
+
+// Reference points hashed into square cells of the pairing distance: the nearest point within
+// that distance lies in the 3 x 3 cells around a query.
+class PointHash {
+ public:
+  PointHash(const std::vector<Eigen::Vector2d>& points, double cell)
+      : points_(points), cell_(cell) {
+    for (std::size_t i = 0; i < points.size(); ++i) cells_[key(cell_of(points[i]))].push_back(i);
+  }
+  /// Distance to the nearest point, or a negative value when none lies within `cell`.
+  double nearest(const Eigen::Vector2d& p) const {
+    const Eigen::Vector2i c = cell_of(p);
+    double best = -1.0;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy) {
+        const auto it = cells_.find(key(c + Eigen::Vector2i(dx, dy)));
+        if (it == cells_.end()) continue;
+        for (std::size_t i : it->second) {
+          const double d = (points_[i] - p).norm();
+          if (d <= cell_ && (best < 0.0 || d < best)) best = d;
+        }
+      }
+    return best;
+  }
+
+ private:
+  Eigen::Vector2i cell_of(const Eigen::Vector2d& p) const {
+    return Eigen::Vector2i(static_cast<int>(std::floor(p.x() / cell_)),
+                           static_cast<int>(std::floor(p.y() / cell_)));
+  }
+  static std::int64_t key(const Eigen::Vector2i& c) {
+    return (static_cast<std::int64_t>(c.x()) << 32) ^ static_cast<std::uint32_t>(c.y());
+  }
+  const std::vector<Eigen::Vector2d>& points_;
+  double cell_;
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
+};
+
+// The farthest return of a scan per bearing bin, in its own frame: what it saw to be free.
+class RangeProfile {
+ public:
+  explicit RangeProfile(const std::vector<Eigen::Vector2d>& points) : ranges_(kBins, -1.0) {
+    for (const Eigen::Vector2d& p : points) {
+      double& r = ranges_[bin(p)];
+      r = std::max(r, p.norm());
+    }
+  }
+  /// True when `p` (in this scan's frame) lies more than `margin` in front of the return seen
+  /// along its bearing (and the neighbouring bins agree, so that an edge does not count).
+  bool in_free_space(const Eigen::Vector2d& p, double margin) const {
+    const std::size_t b = bin(p);
+    const double r = p.norm() + margin;
+    for (std::size_t d : {kBins - 1, std::size_t{0}, std::size_t{1}}) {
+      const double seen = ranges_[(b + d) % kBins];
+      if (seen < 0.0 || seen <= r) return false;
+    }
+    return true;
+  }
+
+ private:
+  static constexpr std::size_t kBins = 720;  // 0.5 deg
+  static std::size_t bin(const Eigen::Vector2d& p) {
+    const double a = std::atan2(p.y(), p.x()) + M_PI;  // [0, 2 pi]
+    return static_cast<std::size_t>(a / (2 * M_PI) * kBins) % kBins;
+  }
+  std::vector<double> ranges_;
+};
+
+struct OverlapCheck {
+  double paired_fraction = 0.0, error = 0.0, free_violations = 0.0, constraint = 0.0;
+};
+
+// Unit normal of point j from its beam neighbours (zero where they are missing or far).
+Eigen::Vector2d beam_normal(const Scan2D& scan, std::size_t j) {
+  constexpr double kMaxGap = 0.3;  // m: farther neighbours lie on another surface
+  const long prev = beam_neighbour(scan, j, -1), next = beam_neighbour(scan, j, 1);
+  const Eigen::Vector2d& p = scan.points[j];
+  const Eigen::Vector2d a =
+      prev >= 0 && (scan.points[static_cast<std::size_t>(prev)] - p).norm() < kMaxGap
+          ? scan.points[static_cast<std::size_t>(prev)]
+          : p;
+  const Eigen::Vector2d b =
+      next >= 0 && (scan.points[static_cast<std::size_t>(next)] - p).norm() < kMaxGap
+          ? scan.points[static_cast<std::size_t>(next)]
+          : p;
+  const Eigen::Vector2d t = b - a;
+  if (t.norm() < 1e-6) return Eigen::Vector2d::Zero();
+  return Eigen::Vector2d(-t.y(), t.x()).normalized();
+}
+
+// `from`'s points moved by `T` against `onto`'s points and free space.
+OverlapCheck check_overlap(const Scan2D& from, const Scan2D& onto, const Pose2& T,
+                           double pair_distance, double free_margin) {
+  const PointHash hash(onto.points, pair_distance);
+  const RangeProfile profile(onto.points);
+  std::size_t paired = 0, free = 0;
+  double sum = 0.0;
+  Eigen::Matrix2d normals = Eigen::Matrix2d::Zero();
+  for (std::size_t j = 0; j < from.points.size(); ++j) {
+    const Eigen::Vector2d q = T * from.points[j];
+    const double d = hash.nearest(q);
+    if (d >= 0.0) {
+      ++paired;
+      sum += d;
+      const Eigen::Vector2d n = beam_normal(from, j);
+      normals += n * n.transpose();
+    } else if (profile.in_free_space(q, free_margin)) {
+      ++free;
+    }
+  }
+  OverlapCheck c;
+  const double n = static_cast<double>(std::max<std::size_t>(from.points.size(), 1));
+  c.paired_fraction = static_cast<double>(paired) / n;
+  c.free_violations = static_cast<double>(free) / n;
+  c.error = paired > 0 ? sum / static_cast<double>(paired) : 1e9;
+  const double trace = normals.trace();
+  if (trace > 0.0) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(normals / trace);
+    c.constraint = eigen.eigenvalues()(0);  // ascending: the weaker direction
+  }
+  return c;
+}
+
+Eigen::Matrix3d diagonal_information(double sigma_xy, double sigma_theta) {
+  return Eigen::Vector3d(1 / (sigma_xy * sigma_xy), 1 / (sigma_xy * sigma_xy),
+                         1 / (sigma_theta * sigma_theta))
+      .asDiagonal();
+}
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+      .count();
+}
+
+}  // namespace
+
+LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
+                                  const Pose2& initial, const LoopVerification2DOptions& options) {
+  LoopVerification2D out;
+  out.transform = initial;
+  const std::size_t min_points = std::max<std::size_t>(options.min_points, 3);
+  if (current.points.size() < min_points || candidate.points.size() < min_points ||
+      !finite_scan(current) || !finite_scan(candidate) || !initial.matrix().allFinite())
+    return out;
+  Registration2DOptions r;
+  r.method = options.method;
+  r.search_window = options.search_window;
+  r.search_angle = options.search_angle;
+  r.search_resolution = options.search_resolution;
+  r.max_correspondence_distance = options.max_correspondence_distance;
+  try {
+    out.transform = register_scans(current, candidate, r, initial).transform;
+  } catch (const Error&) {
+    return out;  // too few usable points for the method: not verifiable, so not a loop
+  }
+  if (!out.transform.matrix().allFinite()) return out;
+  const OverlapCheck forward =
+      check_overlap(current, candidate, out.transform, options.pair_distance, options.free_margin);
+  const OverlapCheck backward = check_overlap(candidate, current, out.transform.inverse(),
+                                              options.pair_distance, options.free_margin);
+  out.paired_fraction = std::min(forward.paired_fraction, backward.paired_fraction);
+  out.error = std::max(forward.error, backward.error);
+  out.free_violations = std::max(forward.free_violations, backward.free_violations);
+  out.constraint = std::min(forward.constraint, backward.constraint);
+  out.accepted = out.paired_fraction >= options.min_paired_fraction &&
+                 out.error <= options.max_error &&
+                 out.free_violations <= options.max_free_violations &&
+                 out.constraint >= options.min_constraint;
+  return out;
+}
+
+LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
+    : options_(options), graph_(options.graph) {
+  check_registration_2d_method(options.verification.method);
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(options.odometry_sigma_xy) || !positive(options.odometry_sigma_theta) ||
+      !positive(options.loop_sigma_xy) || !positive(options.loop_sigma_theta))
+    throw Error("loop closure: the edge standard deviations must be positive");
+  if (!positive(options.verification.pair_distance) ||
+      !positive(options.verification.search_window) ||
+      !positive(options.verification.search_resolution))
+    throw Error("loop closure: pair distance, search window and resolution must be positive");
+  if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
+    throw Error("loop closure: keyframe thresholds must not be negative");
+  options_.search_every = std::max<std::size_t>(options_.search_every, 1);
+}
+
+bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
+  const auto start = std::chrono::steady_clock::now();
+  // A non-finite odometry pose would poison the graph: hold the last one instead.
+  Pose2 odometry = odometry_pose;
+  if (!odometry.matrix().allFinite())
+    odometry =
+        keyframes_.empty() ? Pose2::Identity() : keyframes_.back().odometry * scan_offset_.back();
+  bool new_keyframe = keyframes_.empty();
+  if (!new_keyframe) {
+    const Pose2 motion = keyframes_.back().odometry.inverse() * odometry;
+    new_keyframe = motion.translation().norm() >= options_.keyframe_distance ||
+                   std::abs(pose2_angle(motion)) >= options_.keyframe_angle;
+  }
+  if (new_keyframe) {
+    Keyframe k;
+    k.scan = scan_keyframe_.size();
+    k.points = scan;
+    k.odometry = odometry;
+    const std::size_t index = keyframes_.size();
+    if (index == 0) {
+      graph_.add_node(odometry);
+      keyframes_.push_back(std::move(k));
+    } else {
+      const Keyframe& previous = keyframes_.back();
+      const Pose2 measurement = previous.odometry.inverse() * odometry;
+      k.path = previous.path + measurement.translation().norm();
+      graph_.add_node(graph_.pose(index - 1) * measurement);
+      graph_.add_edge(
+          index - 1, index, measurement,
+          diagonal_information(options_.odometry_sigma_xy, options_.odometry_sigma_theta),
+          EdgeKind::kOdometry);
+      keyframes_.push_back(std::move(k));
+    }
+    places_.add(make_place_descriptor(scan, options_.descriptor));
+    ++counts_.keyframes;
+    if (index % options_.search_every == 0) close_loops(index);
+  }
+  scan_keyframe_.push_back(keyframes_.size() - 1);
+  scan_offset_.push_back(keyframes_.back().odometry.inverse() * odometry);
+  counts_.total_ms += elapsed_ms(start);
+  return new_keyframe;
+}
+
+void LoopClosure2D::close_loops(std::size_t keyframe) {
+  if (keyframe <= options_.skip_recent) return;
+  const std::size_t last_candidate = keyframe - options_.skip_recent;  // exclusive
+  const Pose2& here = graph_.pose(keyframe);
+  // Candidates with the relative pose each implies (current keyframe in the candidate's frame).
+  std::vector<std::pair<std::size_t, Pose2>> candidates;
+  if (options_.max_proximity_candidates > 0) {
+    std::vector<std::pair<double, std::size_t>> near;
+    for (std::size_t k = 0; k < last_candidate; ++k) {
+      const double d = (graph_.pose(k).translation() - here.translation()).norm();
+      if (d <= options_.proximity_radius) near.emplace_back(d, k);
+    }
+    std::sort(near.begin(), near.end());
+    // Nearest first, but not several neighbours of one visit: they would verify the same loop.
+    std::vector<std::size_t> chosen;
+    for (const auto& [d, k] : near) {
+      if (chosen.size() >= options_.max_proximity_candidates) break;
+      const bool same_visit = std::any_of(chosen.begin(), chosen.end(), [&](std::size_t c) {
+        return (c > k ? c - k : k - c) < options_.skip_recent / 2 + 1;
+      });
+      if (same_visit) continue;
+      chosen.push_back(k);
+      candidates.emplace_back(k, graph_.pose(k).inverse() * here);
+    }
+  }
+  if (options_.max_descriptor_candidates > 0) {
+    const auto found = places_.query(places_.at(keyframe), options_.skip_recent + 1,
+                                     options_.max_descriptor_candidates);
+    for (const PlaceCandidate& c : found) {
+      if (c.distance > options_.max_descriptor_distance || c.index >= last_candidate) continue;
+      const bool known = std::any_of(candidates.begin(), candidates.end(),
+                                     [&](const auto& p) { return p.first == c.index; });
+      // The descriptor knows the yaw only: the translation is left to the search window.
+      if (!known) candidates.emplace_back(c.index, pose2(0.0, 0.0, c.yaw));
+    }
+  }
+  bool added = false;
+  for (const auto& [k, initial] : candidates) {
+    ++counts_.candidates;
+    const LoopVerification2D v = verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points,
+                                                initial, options_.verification);
+    if (!v.accepted) {
+      ++counts_.rejected_by_verification;
+      continue;
+    }
+    const Pose2 estimated = graph_.pose(k).inverse() * here;
+    const double allowed =
+        options_.max_correction +
+        options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
+    if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
+      ++counts_.rejected_by_estimate;
+      continue;
+    }
+    ++counts_.verified;
+    Loop2D loop;
+    loop.from_keyframe = k;
+    loop.to_keyframe = keyframe;
+    loop.from_scan = keyframes_[k].scan;
+    loop.to_scan = keyframes_[keyframe].scan;
+    loop.relative = v.transform;
+    loop.paired_fraction = v.paired_fraction;
+    loop.error = v.error;
+    loop_edges_.push_back(graph_.add_edge(
+        k, keyframe, v.transform,
+        diagonal_information(options_.loop_sigma_xy, options_.loop_sigma_theta), EdgeKind::kLoop));
+    loops_.push_back(loop);
+    added = true;
+  }
+  if (added) optimize();
+}
+
+void LoopClosure2D::optimize() {
+  const PoseGraphSummary s = graph_.optimize();
+  ++counts_.optimizations;
+  for (std::size_t i = 0; i < loops_.size(); ++i)
+    loops_[i].outlier = std::find(s.outlier_edges.begin(), s.outlier_edges.end(), loop_edges_[i]) !=
+                        s.outlier_edges.end();
+  counts_.outliers = s.outlier_edges.size();
+}
+
+void LoopClosure2D::finish() {
+  const auto start = std::chrono::steady_clock::now();
+  if (!loops_.empty()) optimize();
+  counts_.total_ms += elapsed_ms(start);
+}
+
+Pose2 LoopClosure2D::pose(std::size_t index) const {
+  return graph_.pose(scan_keyframe_.at(index)) * scan_offset_.at(index);
+}
+
+std::vector<Pose2> LoopClosure2D::poses() const {
+  std::vector<Pose2> out;
+  out.reserve(scans());
+  for (std::size_t i = 0; i < scans(); ++i) out.push_back(pose(i));
+  return out;
+}
+
+}  // namespace scanmatch

@@ -1,0 +1,155 @@
+// 2D loop closure (mapping/loop_closure2d.hpp): on a simulated sequence it must reduce the error
+// against the simulator's truth, verification must reject two different places, and
+// `map2d --loop-closure` must write its files.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "scanmatch/eval/metrics2d.hpp"
+#include "scanmatch/mapping/loop_closure2d.hpp"
+#include "scanmatch/odometry/mapper2d.hpp"
+#include "scanmatch/odometry/run2d.hpp"
+#include "scanmatch/sim/simulator.hpp"
+#include "test_helpers.hpp"
+
+namespace scanmatch {
+namespace {
+
+Scans2D room_scans(std::size_t count) {
+  SequenceOptions o;
+  o.simulator.motion_distortion = false;
+  return load_scans_2d("sim:room-2d", o, count);
+}
+
+TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
+  // The simulated scans with an odometry that drifts in a known way: each step's true motion
+  // with a heading bias of 0.04 deg and 1 % too long. room-2d's rooms are identical and its hallway
+  // has doors every 5 m, so the drift is kept below the 2.5 m where those would alias.
+  const Scans2D input = room_scans(500);
+  std::vector<Pose2> reference, odometry;
+  LoopClosure2D loops;
+  for (std::size_t i = 0; i < input.scans.size(); ++i) {
+    reference.push_back(pose2(input.scans[i].pose));
+    if (i == 0) {
+      odometry.push_back(Pose2::Identity());
+    } else {
+      Pose2 step = reference[i - 1].inverse() * reference[i];
+      step.translation() *= 1.01;
+      odometry.push_back(odometry.back() * step * pose2(0, 0, 0.04 * M_PI / 180));
+    }
+    loops.add_scan(scan_from_laser(input.scans[i], 0.05, 0.0, 0.0), odometry.back());
+  }
+  loops.finish();
+  const std::vector<Pose2> optimized = loops.poses();
+  ASSERT_EQ(optimized.size(), odometry.size());
+  const AbsoluteError2D before = absolute_trajectory_error_2d(reference, odometry);
+  const AbsoluteError2D after = absolute_trajectory_error_2d(reference, optimized);
+  const LoopClosure2DCounts& c = loops.counts();
+  std::printf(
+      "room-2d 500 scans: ATE odometry %.3f m, loop-closed %.3f m; %zu keyframes, %zu "
+      "candidates, %zu verified, %zu outliers, %.2f ms per scan\n",
+      before.rmse, after.rmse, c.keyframes, c.candidates, c.verified, c.outliers,
+      c.total_ms / static_cast<double>(optimized.size()));
+  EXPECT_GT(before.rmse, 0.3);
+  EXPECT_GT(c.verified, 0u);
+  EXPECT_LT(after.rmse, 0.5 * before.rmse);
+  // Every accepted loop agrees with the truth: its relative pose is within a few cm.
+  for (const Loop2D& l : loops.loops()) {
+    if (l.outlier) continue;
+    const Pose2 truth = reference[l.from_scan].inverse() * reference[l.to_scan];
+    const Pose2 error = truth.inverse() * l.relative;
+    EXPECT_LT(error.translation().norm(), 0.15) << l.from_scan << " -> " << l.to_scan;
+  }
+}
+
+TEST(LoopClosure2D, VerificationRejectsTwoDifferentPlaces) {
+  const Scans2D input = room_scans(400);
+  const auto scan = [&](std::size_t i) { return scan_from_laser(input.scans[i], 0.05, 0.0, 0.0); };
+  const LoopVerification2DOptions options;
+  // A scan against itself from a guess 0.3 m and 5 deg off: the same place.
+  const LoopVerification2D same =
+      verify_loop_2d(scan(10), scan(10), pose2(0.3, -0.2, 0.09), options);
+  EXPECT_TRUE(same.accepted) << same.paired_fraction << " " << same.error << " "
+                             << same.free_violations;
+  EXPECT_LT(same.transform.translation().norm(), 0.02);
+  // A scan in a room against scans in the hallway (the rooms are identical copies, so only a
+  // room against the hallway is surely two different places): every guess the candidate sources
+  // could give (the identity, and the descriptor's best yaw) must be rejected.
+  sim::SimOptions so;
+  so.preset = "room-2d";
+  const sim::Simulator simulator(so);
+  const Pose scene_from_world = simulator.scene_pose_at(0.0);
+  const Pose2 first = pose2(input.scans[0].pose);
+  const auto scene_y = [&](std::size_t i) {
+    const Eigen::Vector2d p = (first.inverse() * pose2(input.scans[i].pose)).translation();
+    return (scene_from_world * Eigen::Vector3d(p.x(), p.y(), 0.0)).y();
+  };
+  std::size_t compared = 0;
+  for (std::size_t a = 0; a < input.scans.size(); a += 20)
+    for (std::size_t b = 10; b < input.scans.size(); b += 40) {
+      if (!(scene_y(a) < 3.0 && scene_y(b) > 4.8)) continue;
+      ++compared;
+      const PlaceMatch match =
+          compare(make_place_descriptor(scan(b)), make_place_descriptor(scan(a)));
+      for (const Pose2& guess : {Pose2(Pose2::Identity()), pose2(0, 0, match.yaw)}) {
+        const LoopVerification2D v = verify_loop_2d(scan(b), scan(a), guess, options);
+        EXPECT_FALSE(v.accepted) << a << " vs " << b << ": " << v.paired_fraction << " " << v.error
+                                 << " " << v.free_violations << " " << v.constraint;
+      }
+    }
+  std::printf("%zu room / hallway pairs compared\n", compared);
+  EXPECT_GT(compared, 0u);
+  // Bad input never crashes: empty and non-finite scans are rejected.
+  Scan2D empty, broken = scan(0);
+  broken.points[3].x() = std::nan("");
+  EXPECT_FALSE(verify_loop_2d(empty, scan(0), Pose2::Identity(), options).accepted);
+  EXPECT_FALSE(verify_loop_2d(broken, scan(0), Pose2::Identity(), options).accepted);
+}
+
+TEST(LoopClosure2D, CliWritesTheLoopClosedRun) {
+  scanmatch::testing::TempDir dir;
+  const auto r = scanmatch::testing::run_cli(
+      "map2d sim:room-2d --scans 300 --method pl-icp --no-motion-distortion --loop-closure "
+      "--reference-map --quiet --out " +
+      dir.file("run"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* name : {"poses_tum.txt", "poses_optimized_tum.txt", "loops.json", "summary.json",
+                           "config.json", "map.pgm", "map.yaml", "map.png", "map_odometry.pgm",
+                           "map_odometry.yaml", "map_odometry.png", "map_reference.pgm"})
+    EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("run/") + name))) << name;
+  std::ifstream poses(dir.file("run/poses_optimized_tum.txt"));
+  std::size_t lines = 0;
+  for (std::string l; std::getline(poses, l);) lines += !l.empty() && l[0] != '#';
+  EXPECT_EQ(lines, 300u);
+  const auto loops = nlohmann::json::parse(std::ifstream(dir.file("run/loops.json")));
+  ASSERT_TRUE(loops.is_array());
+  for (const auto& l : loops) {
+    EXPECT_LT(l.at("from").get<int>(), l.at("to").get<int>());
+    EXPECT_GE(l.at("paired_fraction").get<double>(), 0.6);
+  }
+  const auto summary = nlohmann::json::parse(std::ifstream(dir.file("run/summary.json")));
+  ASSERT_TRUE(summary.contains("loop_closure"));
+  EXPECT_EQ(summary["loop_closure"]["accepted"].get<std::size_t>(), loops.size());
+  EXPECT_TRUE(summary.contains("ate") && summary.contains("ate_odometry"));
+  const auto config = nlohmann::json::parse(std::ifstream(dir.file("run/config.json")));
+  EXPECT_TRUE(config.at("loop_closure").get<bool>());
+}
+
+TEST(LoopClosure2D, CarmenLogStartIfPresent) {
+  const std::string log = scanmatch::testing::shared_data("data/2d/carmen/intel-corrected.log.gz");
+  if (log.empty()) GTEST_SKIP() << "../shared/data/2d/carmen is absent";
+  scanmatch::testing::TempDir dir;
+  const auto r = scanmatch::testing::run_cli(
+      "map2d " + log + " --scans 1500 --loop-closure --quiet --out " + dir.file("run"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto summary = nlohmann::json::parse(std::ifstream(dir.file("run/summary.json")));
+  EXPECT_LE(summary["ate"]["rmse_m"].get<double>(),
+            summary["ate_odometry"]["rmse_m"].get<double>() * 1.05);
+}
+
+}  // namespace
+}  // namespace scanmatch
