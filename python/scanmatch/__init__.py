@@ -10,6 +10,8 @@ as numpy arrays:
 * ``read_cloud(path)`` / ``write_cloud(path, points, ...)``
 * ``eval.ate(gt_poses, est_poses)`` / ``eval.rpe(...)``
 * 2D: ``register2d(current, reference, ...)`` and ``Mapper2D``
+* loop closure: ``LoopClosure2D(**options)`` with ``add_scan(points, odometry_pose)``, ``finish()``,
+  ``poses`` (optimized, N x 3 x 3) and ``loops``
 
 Copies: arrays passed in are copied once into the library's layout (a ``PointCloud`` is used in
 place, so convert once for repeated use); clouds coming out (``read_cloud``, simulated frames)
@@ -31,12 +33,14 @@ import numpy as np
 from . import _scanmatch
 from ._scanmatch import (
     Error,
+    LoopClosure2D,
     Mapper2D,
     Odometry,
     PointCloud,
     Registration2DResult,
     RegistrationResult,
     Simulator,
+    loop_closure_2d_options,
     mapper2d_options,
     odometry_options,
     presets,
@@ -54,13 +58,14 @@ from . import eval  # noqa: A004  (scanmatch.eval, as the CLI's `scanmatch eval`
 __version__ = _scanmatch.__version__
 
 # Shown as scanmatch.X in messages and reprs (they live in the compiled scanmatch._scanmatch).
-for _cls in (Error, Mapper2D, Odometry, PointCloud, Registration2DResult, RegistrationResult,
+for _cls in (Error, LoopClosure2D, Mapper2D, Odometry, PointCloud, Registration2DResult, RegistrationResult,
              Simulator):
     _cls.__module__ = __name__
 del _cls
 
 __all__ = [
     "Error",
+    "LoopClosure2D",
     "Mapper2D",
     "Odometry",
     "PointCloud",
@@ -69,6 +74,7 @@ __all__ = [
     "Simulation",
     "Simulator",
     "eval",
+    "loop_closure_2d_options",
     "mapper2d_options",
     "odometry_methods",
     "odometry_options",

@@ -139,4 +139,70 @@ py::array_t<double> poses_to_array(const std::vector<Pose>& poses) {
   return out;
 }
 
+Scan2D scan_from_arrays(py::handle points, py::handle times, bool circular,
+                        const std::string& name) {
+  const auto a = as_matrix(points, name, 2);
+  Scan2D scan;
+  scan.circular = circular;
+  scan.points.resize(static_cast<std::size_t>(a.shape(0)));
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    scan.points[i] =
+        Eigen::Vector2d(a.at(static_cast<py::ssize_t>(i), 0), a.at(static_cast<py::ssize_t>(i), 1));
+    if (!scan.points[i].allFinite())
+      throw py::value_error(name + ": point " + std::to_string(i) + " has a non-finite coordinate");
+  }
+  if (!times.is_none()) {
+    const auto t = as_vector(times, "times", a.shape(0));
+    scan.times.assign(t.data(), t.data() + scan.points.size());
+    for (std::size_t i = 0; i < scan.times.size(); ++i)
+      if (!std::isfinite(scan.times[i]))
+        throw py::value_error("times: entry " + std::to_string(i) + " is not finite");
+  }
+  return scan;
+}
+
+// A 3x3 homogeneous matrix or (x, y, theta); None: the identity.
+Pose2 pose2_from(py::handle obj, const std::string& name) {
+  if (obj.is_none()) return Pose2::Identity();
+  const py::array a = py::array::ensure(obj);
+  const bool vector = a && a.ndim() == 1 && a.shape(0) == 3;
+  const bool matrix = a && a.ndim() == 2 && a.shape(0) == 3 && a.shape(1) == 3;
+  if (!vector && !matrix) throw py::value_error(name + ": expected a 3x3 matrix or (x, y, theta)");
+  if (vector) {
+    const auto v = as_vector(obj, name, 3);
+    const Eigen::Vector3d xyt(v.at(0), v.at(1), v.at(2));
+    if (!xyt.allFinite()) throw py::value_error(name + ": (x, y, theta) must be finite");
+    return pose2(xyt);
+  }
+  const auto m = as_matrix(obj, name, 3);
+  Eigen::Matrix3d M;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) M(r, c) = m.at(r, c);
+  if (!M.allFinite()) throw py::value_error(name + ": the transform has non-finite entries");
+  if ((M.row(2) - Eigen::RowVector3d(0, 0, 1)).norm() > 1e-9)
+    throw py::value_error(name + ": the last row of a 3x3 transform must be 0 0 1");
+  const Eigen::Matrix2d R = M.topLeftCorner<2, 2>();
+  if ((R.transpose() * R - Eigen::Matrix2d::Identity()).norm() > 1e-4 || R.determinant() < 0)
+    throw py::value_error(name + ": the rotation block is not a rotation matrix");
+  return pose2(M(0, 2), M(1, 2), std::atan2(M(1, 0), M(0, 0)));
+}
+
+py::array_t<double> pose2_to_array(const Pose2& T) {
+  py::array_t<double> out({3, 3});
+  auto o = out.mutable_unchecked<2>();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) o(r, c) = T.matrix()(r, c);
+  return out;
+}
+
+py::array_t<double> poses2_to_array(const std::vector<Pose2>& poses) {
+  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{3}, py::ssize_t{3}});
+  auto o = out.mutable_unchecked<3>();
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 3; ++col)
+        o(static_cast<py::ssize_t>(i), r, col) = poses[i].matrix()(r, col);
+  return out;
+}
+
 }  // namespace scanmatch::python

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
+#include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/core/se3.hpp"
 
 namespace scanmatch::python {
@@ -51,6 +52,16 @@ py::array_t<double> pose_to_array(const Pose& pose);
 /// An (N, 4, 4) array (or a sequence of 4x4 arrays) as poses.
 std::vector<Pose> poses_from_array(py::handle obj, const std::string& name);
 py::array_t<double> poses_to_array(const std::vector<Pose>& poses);
+
+/// An (N, 2) array of x y (laser frame, beam order) as a 2D scan (one copy); `times`: None or
+/// (N,) s after the first beam. Non-finite values raise ValueError.
+Scan2D scan_from_arrays(py::handle points, py::handle times, bool circular,
+                        const std::string& name);
+/// A 3x3 homogeneous rigid transform or (x, y, theta); None gives the identity.
+Pose2 pose2_from(py::handle obj, const std::string& name);
+py::array_t<double> pose2_to_array(const Pose2& T);
+/// (N, 3, 3) float64 copies.
+py::array_t<double> poses2_to_array(const std::vector<Pose2>& poses);
 
 /// A writable-flag-cleared numpy view of `count` x `columns` values at `data`, owned by `owner`.
 template <typename T>

@@ -19,4 +19,5 @@ PYBIND11_MODULE(_scanmatch, m) {
   bind_simulator(m);
   bind_eval(m);
   bind_planar(m);
+  bind_mapping(m);
 }

@@ -59,6 +59,13 @@ void FieldTable::assign(const std::string& path, std::uint32_t& field, py::handl
   field = static_cast<std::uint32_t>(v);
 }
 
+void FieldTable::assign(const std::string& path, unsigned long& field, py::handle value) const {
+  if (!is_integer(value)) wrong_type(path, "a non-negative integer", value);
+  const long long v = value.cast<long long>();
+  if (v < 0) throw py::value_error(function_ + ": option '" + path + "' must not be negative");
+  field = static_cast<unsigned long>(v);
+}
+
 void FieldTable::assign(const std::string& path, bool& field, py::handle value) const {
   if (!PyBool_Check(value.ptr()) && !is_numpy_scalar(value, "bool_"))
     wrong_type(path, "True or False", value);

@@ -80,6 +80,7 @@ class FieldTable {
   void assign(const std::string& path, int& field, py::handle value) const;
   void assign(const std::string& path, long& field, py::handle value) const;
   void assign(const std::string& path, std::uint32_t& field, py::handle value) const;
+  void assign(const std::string& path, unsigned long& field, py::handle value) const;
   void assign(const std::string& path, bool& field, py::handle value) const;
   void assign(const std::string& path, std::string& field, py::handle value) const;
   /// Enumerations by name (enum_name / enum_from_name of config_fields.hpp).

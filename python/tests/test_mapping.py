@@ -1,0 +1,83 @@
+"""Loop closure: LoopClosure2D over a drifting odometry of simulated room-2d scans."""
+
+import unittest
+
+import numpy as np
+
+import scanmatch
+
+
+def planar(x, y, theta):
+    return np.array([[np.cos(theta), -np.sin(theta), x],
+                     [np.sin(theta), np.cos(theta), y], [0.0, 0.0, 1.0]])
+
+
+def planar_of(pose):
+    """x, y and yaw of a 4x4 pose of a 2D preset, as a 3x3 pose."""
+    return planar(pose[0, 3], pose[1, 3], np.arctan2(pose[1, 0], pose[0, 0]))
+
+
+def orthonormal(pose):
+    return planar(pose[0, 2], pose[1, 2], np.arctan2(pose[1, 0], pose[0, 0]))
+
+
+def rmse(truth, estimate):
+    """Position RMSE after a rigid 2D alignment of estimate onto truth (m)."""
+    a, b = estimate[:, :2, 2], truth[:, :2, 2]
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    u, _, vt = np.linalg.svd((a - ca).T @ (b - cb))
+    d = np.diag([1.0, np.sign(np.linalg.det(vt.T @ u.T))])
+    rotation = vt.T @ d @ u.T
+    return float(np.sqrt((((a - ca) @ rotation.T + cb - b) ** 2).sum(axis=1).mean()))
+
+
+class LoopClosure(unittest.TestCase):
+    def test_loop_closure_2d_removes_a_known_drift(self):
+        sim = scanmatch.Simulator("room-2d", frames=500, seed=1, motion_distortion=False)
+        truth = np.stack([planar_of(sim.pose(i)) for i in range(len(sim))])
+        # The true steps, 1 % too long and turned by 0.04 deg each: an odometry that drifts.
+        odometry = [truth[0]]
+        for i in range(1, len(truth)):
+            step = np.linalg.inv(truth[i - 1]) @ truth[i]
+            step[:2, 2] *= 1.01
+            odometry.append(orthonormal(odometry[-1] @ step @ planar(0, 0, np.radians(0.04))))
+        odometry = np.stack(odometry)
+        closure = scanmatch.LoopClosure2D(skip_recent=30, verification={"min_paired_fraction": 0.65})
+        keyframes = 0
+        for i in range(len(sim)):
+            points, circular = sim.scan2d(i)
+            keyframes += closure.add_scan(points, odometry[i], circular=circular)
+        closure.finish()
+        self.assertEqual(len(closure), 500)
+        self.assertEqual(closure.poses.shape, (500, 3, 3))
+        self.assertEqual(closure.counts["keyframes"], keyframes)
+        before, after = rmse(truth, odometry), rmse(truth, closure.poses)
+        self.assertGreater(before, 0.3)
+        self.assertLess(after, 0.5 * before)
+        self.assertGreater(len(closure.loops), 0)
+        for loop in closure.loops:  # every accepted loop agrees with the truth
+            if loop["outlier"]:
+                continue
+            true_relative = np.linalg.inv(truth[loop["from_scan"]]) @ truth[loop["to_scan"]]
+            self.assertLess(np.linalg.norm(loop["relative"][:2, 2] - true_relative[:2, 2]), 0.15)
+
+    def test_options_and_errors(self):
+        options = scanmatch.loop_closure_2d_options()
+        self.assertIn("verification.min_paired_fraction", options)
+        self.assertEqual(options["graph.loop_kernel"], "cauchy")
+        with self.assertRaisesRegex(TypeError, "no_such_option"):
+            scanmatch.LoopClosure2D(no_such_option=1)
+        with self.assertRaisesRegex(ValueError, "kernel"):
+            scanmatch.LoopClosure2D(graph={"loop_kernel": "tukey"})
+        with self.assertRaisesRegex(ValueError, "standard deviations"):
+            scanmatch.LoopClosure2D(loop_sigma_xy=0.0)
+        closure = scanmatch.LoopClosure2D()
+        with self.assertRaisesRegex(ValueError, "non-finite"):
+            closure.add_scan(np.array([[1.0, np.nan], [2.0, 0.0]]), (0.0, 0.0, 0.0))
+        # A scan too small to verify is kept as a keyframe without loops, never an error.
+        self.assertTrue(closure.add_scan(np.zeros((0, 2)), (0.0, 0.0, 0.0)))
+        self.assertEqual(closure.poses.shape, (1, 3, 3))
+
+
+if __name__ == "__main__":
+    unittest.main()
