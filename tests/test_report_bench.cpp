@@ -199,3 +199,40 @@ TEST(Bench, RecordedAviaHku1AgainstItsReference) {
   EXPECT_EQ(md.find("failed"), std::string::npos) << md;
   EXPECT_TRUE(std::filesystem::exists(dir.file("b/runs/avia_hku1/ctf-icp/poses_gt.txt")));
 }
+
+TEST(Report, LoopClosedRunsShowBothTrajectoriesAndTheirLoopEdges) {
+  TempDir dir;
+  const std::string run = dir.file("run");
+  ASSERT_EQ(
+      run_cli("odometry sim:dynamic-outdoor-fast --frames 8 --quiet --method ctf-icp --out " + run)
+          .status,
+      0);
+  // A loop closure that found the truth, with two loop edges.
+  std::filesystem::copy_file(run + "/poses_gt_tum.txt", run + "/poses_optimized_tum.txt");
+  std::ofstream(run + "/loops.json") << R"([{"from": 0, "to": 7}, {"from": 2, "to": 6}])";
+  const RunFolder folder = read_run_folder(run);
+  ASSERT_TRUE(folder.optimized.has_value());
+  EXPECT_EQ(folder.optimized->size(), folder.poses.size());
+  ASSERT_EQ(folder.loops.size(), 2u);
+  EXPECT_EQ(folder.loops[1], std::make_pair(std::size_t{2}, std::size_t{6}));
+  const std::string html = render_report({folder}, std::nullopt);
+  // Its own table row with an ATE of zero (it is the reference), the odometry dashed under it,
+  // and the loop edges in the legend.
+  const auto row = html.find("<td>run (loop-closed)</td>");
+  ASSERT_NE(row, std::string::npos);
+  const std::string cells = html.substr(row, html.find("</tr>", row) - row);
+  EXPECT_NE(cells.find("<td>0.000</td>"), std::string::npos) << cells;
+  EXPECT_NE(cells.find("2 loops"), std::string::npos) << cells;
+  EXPECT_NE(html.find("loop edges (2)"), std::string::npos);
+
+  // A loop edge past the run's frames is refused, naming the file.
+  std::ofstream(run + "/loops.json") << R"([{"from": 0, "to": 99}])";
+  try {
+    read_run_folder(run);
+    FAIL() << "a loop edge past the frames was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("loops.json"), std::string::npos) << e.what();
+  }
+  std::ofstream(run + "/loops.json") << R"({"from": 0})";
+  EXPECT_THROW(read_run_folder(run), Error);
+}

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "scanmatch/core/error.hpp"
@@ -216,36 +217,66 @@ std::string render_report(const std::vector<RunFolder>& runs,
     for (const auto& t : run.timing)
       mean_ms += t.stats.total_ms / static_cast<double>(run.timing.size());
     for (const auto& t : run.timing) bridged += t.stats.bridged;
-    std::string accuracy = "<td>-</td><td>-</td><td>-</td><td>-</td><td>-</td>";
-    if (gt) {
-      const Association pairs = associate(*gt, run.poses, /*allow_partial=*/true);
+    // ATE, RPE and drift of `poses` against the reference as table cells; adds the reference
+    // path once and `poses`' error over distance.
+    const auto accuracy = [&](const Trajectory& poses, const std::string& label,
+                              const std::string& color) -> std::string {
+      if (!gt) return "<td>-</td><td>-</td><td>-</td><td>-</td><td>-</td>";
+      const Association pairs = associate(*gt, poses, /*allow_partial=*/true);
       const AteResult ate = compute_ate(pairs.ground_truth, pairs.estimate);
       const RpeResult rpe = compute_rpe_frames(pairs.ground_truth, pairs.estimate, 1);
       const KittiDriftResult kitti = compute_kitti_drift(pairs.ground_truth, pairs.estimate);
-      accuracy = fmt::format(
-          "<td>{:.3f}</td><td>{}</td><td>{:.3f}</td><td>{:.4f}</td><td>{}</td>", ate.rmse,
-          ate.path_length > 0 ? fmt::format("{:.3f}", ate.rmse_percent_of_path) : "still",
-          ate.final_drift, rpe.translation_rmse,
-          kitti.segments > 0 ? fmt::format("{:.2f}", kitti.translation_percent) : "-");
       if (!any_truth) {
         paths.push_back(make_series("ground truth", "#000000", top_view(pairs.ground_truth)));
         paths.back().line_width = 2.5;
         any_truth = true;
       }
-      SvgSeries e = make_series(run.label, palette_color(i));
+      SvgSeries e = make_series(label, color);
       const std::vector<double> distance = cumulative_distances(pairs.ground_truth);
       for (std::size_t k = 0; k < pairs.estimate.size(); ++k)
         e.points.emplace_back(
             distance[k],
             (pairs.estimate[k].translation() - pairs.ground_truth[k].translation()).norm());
       errors.push_back(std::move(e));
-    }
-    paths.push_back(make_series(run.label, palette_color(i), top_view(run.poses.poses)));
+      return fmt::format(
+          "<td>{:.3f}</td><td>{}</td><td>{:.3f}</td><td>{:.4f}</td><td>{}</td>", ate.rmse,
+          ate.path_length > 0 ? fmt::format("{:.3f}", ate.rmse_percent_of_path) : "still",
+          ate.final_drift, rpe.translation_rmse,
+          kitti.segments > 0 ? fmt::format("{:.2f}", kitti.translation_percent) : "-");
+    };
+    const std::string color = palette_color(i);
     html += fmt::format(
         "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.2f}</td>{}"
         "<td>{}</td></tr>\n",
         html_escape(run.label), html_escape(run.method), run.poses.size(), run.frames_per_second,
-        mean_ms, accuracy, bridged);
+        mean_ms, accuracy(run.poses, run.label, color), bridged);
+    paths.push_back(make_series(run.label, color, top_view(run.poses.poses)));
+    if (run.optimized) {
+      // Loop closure: the odometry fades; the optimized poses and the loop edges between them
+      // are drawn over it.
+      paths.back().opacity = 0.45;
+      paths.back().dashed = true;
+      if (gt) {  // likewise its error over distance
+        errors.back().opacity = 0.45;
+        errors.back().dashed = true;
+      }
+      const std::string label = run.label + " (loop-closed)";
+      html += fmt::format(
+          "<tr><td>{}</td><td>{}</td><td>{}</td><td>-</td><td>-</td>{}<td>{} loops</td></tr>\n",
+          html_escape(label), html_escape(run.method), run.optimized->size(),
+          accuracy(*run.optimized, label, color), run.loops.size());
+      const std::vector<Eigen::Vector2d> at = top_view(run.optimized->poses);
+      paths.push_back(make_series(label, color, at));
+      SvgSeries edges = make_series(fmt::format("loop edges ({})", run.loops.size()), "#2ca02c");
+      edges.line_width = 0.8;
+      for (const auto& [from, to] : run.loops) {
+        if (from >= at.size() || to >= at.size()) continue;
+        edges.points.push_back(at[from]);
+        edges.points.push_back(at[to]);
+        edges.points.emplace_back(std::nan(""), std::nan(""));  // a break between edges
+      }
+      paths.push_back(std::move(edges));
+    }
   }
   html += "</table>\n";
 

@@ -38,6 +38,28 @@ RunFolder read_run_folder(const std::string& path) {
     }
   }
   run.has_map = fs::exists(path + "/map.pcd");
+  if (fs::exists(path + "/poses_optimized_tum.txt"))
+    run.optimized = read_trajectory(path + "/poses_optimized_tum.txt");
+  else if (fs::exists(path + "/poses_optimized.txt"))
+    run.optimized = read_trajectory(path + "/poses_optimized.txt");
+  if (fs::exists(path + "/loops.json")) {
+    try {
+      const auto j = nlohmann::json::parse(read_file_bytes(path + "/loops.json"));
+      if (!j.is_array()) fail(path + "/loops.json", "expected an array of loop edges");
+      const std::size_t frames = run.poses.size();
+      for (const auto& edge : j) {
+        const std::size_t from = edge.at("from").get<std::size_t>();
+        const std::size_t to = edge.at("to").get<std::size_t>();
+        if (from >= frames || to >= frames)
+          fail(path + "/loops.json", "loop edge " + std::to_string(from) + " -> " +
+                                         std::to_string(to) + " names a frame past the run's " +
+                                         std::to_string(frames));
+        run.loops.emplace_back(from, to);
+      }
+    } catch (const nlohmann::json::exception& e) {
+      fail(path + "/loops.json", std::string("malformed: ") + e.what());
+    }
+  }
   return run;
 }
 

@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scanmatch/io/trajectory.hpp"
@@ -21,6 +22,10 @@ struct RunFolder {
   double frames_per_second = 0;            ///< from summary.json
   bool interrupted = false;
   bool has_map = false;  ///< map.pcd present
+  /// Loop closure (`--loop-closure`): poses_optimized_tum.txt (or poses_optimized.txt), and the
+  /// accepted loop edges of loops.json as (older frame, newer frame) index pairs.
+  std::optional<Trajectory> optimized;
+  std::vector<std::pair<std::size_t, std::size_t>> loops;
 };
 
 /// Throws Error naming the folder and file when poses are missing or a file is malformed.
