@@ -107,8 +107,11 @@ void add_map2d_command(CLI::App& app) {
               e->step, 1000 * e->mean_translation, e->mean_rotation * 180 / M_PI,
               1000 * e->median_translation, e->median_rotation * 180 / M_PI, 100 * e->failure_rate);
       if (s.ate_odometry.poses > 0)
-        fmt::print("ATE (SE(2)-aligned) of the odometry: rmse {:.3f} m, max {:.3f} m\n",
-                   s.ate_odometry.rmse, s.ate_odometry.max);
+        fmt::print(
+            "ATE (SE(2)-aligned) of the odometry: rmse {:.3f} m, max {:.3f} m; all pairs: "
+            "{:.3f} m, {:.2f} deg mean\n",
+            s.ate_odometry.rmse, s.ate_odometry.max, s.all_pairs_odometry.mean_translation,
+            s.all_pairs_odometry.mean_rotation * 180 / M_PI);
       if (s.loop_closure) {
         fmt::print(
             "loop closure: {} keyframes, {} candidates, {} verified, {} accepted ({} outliers), "
@@ -116,8 +119,11 @@ void add_map2d_command(CLI::App& app) {
             s.loops.keyframes, s.loops.candidates, s.loops.verified, s.accepted_loops,
             s.loops.outliers, s.loop_ms_per_scan);
         if (s.ate_optimized.poses > 0)
-          fmt::print("ATE (SE(2)-aligned) loop-closed: rmse {:.3f} m, max {:.3f} m\n",
-                     s.ate_optimized.rmse, s.ate_optimized.max);
+          fmt::print(
+              "ATE (SE(2)-aligned) loop-closed: rmse {:.3f} m, max {:.3f} m; all pairs: {:.3f} "
+              "m, {:.2f} deg mean\n",
+              s.ate_optimized.rmse, s.ate_optimized.max, s.all_pairs_optimized.mean_translation,
+              s.all_pairs_optimized.mean_rotation * 180 / M_PI);
       }
       if (s.map_agreement >= 0)
         fmt::print("map agreement with map_reference (2 cells): {:.3f}{}\n", s.map_agreement,

@@ -374,6 +374,30 @@ TEST(Metrics2D, RelativeErrorOfAKnownDrift) {
   EXPECT_THROW(relative_pose_error_2d(reference, {}, 1), Error);
 }
 
+TEST(Metrics2D, AllPairsRelativeErrorOfAKnownDrift) {
+  // 1.1 m per step against 1.0 m, 5 poses: pairs k < j are off by 0.1 (j - k) m; the ten pairs
+  // have j - k = 1 four times, 2 three times, 3 twice and 4 once: mean 0.2 m, largest 0.4 m.
+  std::vector<Pose2> reference, estimate;
+  for (int k = 0; k < 5; ++k) {
+    reference.push_back(pose2(k * 1.0, 0, 0));
+    estimate.push_back(pose2(k * 1.1, 0, 0));
+  }
+  const RelativeError2D all = all_pairs_relative_error_2d(reference, estimate);
+  EXPECT_EQ(all.step, 0u);
+  EXPECT_EQ(all.pairs, 10u);
+  EXPECT_NEAR(all.mean_translation, 0.2, 1e-12);
+  EXPECT_NEAR(all.max_translation, 0.4, 1e-12);
+  // 0.3 m twice and 0.4 m once pass a 0.25 m failure threshold.
+  EXPECT_NEAR(all_pairs_relative_error_2d(reference, estimate, 1500, 0.25).failure_rate, 0.3,
+              1e-12);
+  // Thinned to 3 poses (0, 2, 4): pairs off by 0.2, 0.2 and 0.4 m.
+  const RelativeError2D thinned = all_pairs_relative_error_2d(reference, estimate, 3);
+  EXPECT_EQ(thinned.pairs, 3u);
+  EXPECT_NEAR(thinned.mean_translation, 0.8 / 3, 1e-12);
+  EXPECT_EQ(all_pairs_relative_error_2d({}, {}).pairs, 0u);
+  EXPECT_THROW(all_pairs_relative_error_2d(reference, {}), Error);
+}
+
 TEST(Map2D, DeskewingStaysStableOnADistortedSequence) {
   // room-2d with motion distortion. Deskewing each scan by the step before it (the keyframe by an
   // older step) once made the poses oscillate and diverge (10 deg per step); both scans are now

@@ -8,27 +8,34 @@
 
 namespace scanmatch {
 
-RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
-                                       const std::vector<Pose2>& estimate, std::size_t step,
-                                       double failure_translation, double failure_rotation) {
+namespace {
+
+void check_sizes(const std::vector<Pose2>& reference, const std::vector<Pose2>& estimate) {
   if (reference.size() != estimate.size())
     throw Error("relative pose error: " + std::to_string(estimate.size()) +
                 " estimated poses against " + std::to_string(reference.size()) +
                 " reference poses");
-  if (step == 0) throw Error("relative pose error: the step must be at least 1");
+}
+
+// The error of every (k, j) pair that `pairs` visits, summarized.
+template <typename ForEachPair>
+RelativeError2D relative_error_over(const std::vector<Pose2>& reference,
+                                    const std::vector<Pose2>& estimate, std::size_t step,
+                                    double failure_translation, double failure_rotation,
+                                    ForEachPair&& pairs) {
   RelativeError2D r;
   r.step = step;
   std::vector<double> translation, rotation;
   std::size_t failures = 0;
-  for (std::size_t k = 0; k + step < reference.size(); ++k) {
-    const Pose2 truth = reference[k].inverse() * reference[k + step];
-    const Pose2 est = estimate[k].inverse() * estimate[k + step];
+  pairs([&](std::size_t k, std::size_t j) {
+    const Pose2 truth = reference[k].inverse() * reference[j];
+    const Pose2 est = estimate[k].inverse() * estimate[j];
     const Pose2 error = truth.inverse() * est;
     const double t = error.translation().norm(), a = std::abs(pose2_angle(error));
     translation.push_back(t);
     rotation.push_back(a);
     failures += t > failure_translation || a > failure_rotation;
-  }
+  });
   r.pairs = translation.size();
   if (r.pairs == 0) return r;
   r.mean_translation = mean_of(translation);
@@ -39,6 +46,37 @@ RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
   r.max_rotation = *std::max_element(rotation.begin(), rotation.end());
   r.failure_rate = static_cast<double>(failures) / static_cast<double>(r.pairs);
   return r;
+}
+
+}  // namespace
+
+RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
+                                       const std::vector<Pose2>& estimate, std::size_t step,
+                                       double failure_translation, double failure_rotation) {
+  check_sizes(reference, estimate);
+  if (step == 0) throw Error("relative pose error: the step must be at least 1");
+  return relative_error_over(reference, estimate, step, failure_translation, failure_rotation,
+                             [&](const auto& visit) {
+                               for (std::size_t k = 0; k + step < reference.size(); ++k)
+                                 visit(k, k + step);
+                             });
+}
+
+RelativeError2D all_pairs_relative_error_2d(const std::vector<Pose2>& reference,
+                                            const std::vector<Pose2>& estimate,
+                                            std::size_t max_poses, double failure_translation,
+                                            double failure_rotation) {
+  check_sizes(reference, estimate);
+  const std::size_t n = reference.size();
+  const std::size_t kept = std::min(n, std::max<std::size_t>(max_poses, 2));
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < kept; ++i) index.push_back(kept < 2 ? 0 : i * (n - 1) / (kept - 1));
+  return relative_error_over(reference, estimate, 0, failure_translation, failure_rotation,
+                             [&](const auto& visit) {
+                               for (std::size_t a = 0; a < index.size(); ++a)
+                                 for (std::size_t b = a + 1; b < index.size(); ++b)
+                                   visit(index[a], index[b]);
+                             });
 }
 
 AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference,

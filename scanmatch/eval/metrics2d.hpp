@@ -24,6 +24,15 @@ RelativeError2D relative_pose_error_2d(const std::vector<Pose2>& reference,
                                        double failure_translation = 0.2,
                                        double failure_rotation = 5.0 * M_PI / 180);
 
+/// The relative error over all pairs of poses (j > k), the measure of Kuemmerle et al. (2009)
+/// with every pair as a relation; `step` is 0. Longer logs are thinned evenly to `max_poses`
+/// poses first (the pairs grow with the square). Throws Error when the sizes differ.
+RelativeError2D all_pairs_relative_error_2d(const std::vector<Pose2>& reference,
+                                            const std::vector<Pose2>& estimate,
+                                            std::size_t max_poses = 1500,
+                                            double failure_translation = 0.2,
+                                            double failure_rotation = 5.0 * M_PI / 180);
+
 /// Absolute trajectory error of positions after the rigid 2D motion (rotation and translation,
 /// least squares) that best aligns `estimate` onto `reference`.
 struct AbsoluteError2D {

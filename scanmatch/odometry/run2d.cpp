@@ -228,7 +228,11 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     if (summary.scans > 1) summary.one_step = relative_pose_error_2d(reference, estimate, 1);
     if (summary.scans > 10) summary.ten_steps = relative_pose_error_2d(reference, estimate, 10);
     summary.ate_odometry = absolute_trajectory_error_2d(reference, estimate);
-    if (loop_closure) summary.ate_optimized = absolute_trajectory_error_2d(reference, optimized);
+    summary.all_pairs_odometry = all_pairs_relative_error_2d(reference, estimate);
+    if (loop_closure) {
+      summary.ate_optimized = absolute_trajectory_error_2d(reference, optimized);
+      summary.all_pairs_optimized = all_pairs_relative_error_2d(reference, optimized);
+    }
   }
   const bool reference_written = summary.scans > 0 && options.reference_map &&
                                  input.has_reference && summary.reference_map_error.empty();
@@ -296,6 +300,11 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   if (summary.ate_odometry.poses > 0) {
     j["ate"] = ate_json(summary.loop_closure ? summary.ate_optimized : summary.ate_odometry);
     j["ate_odometry"] = ate_json(summary.ate_odometry);
+  }
+  if (summary.all_pairs_odometry.pairs > 0) {
+    j["relative_error_all_pairs"] =
+        error_json(summary.loop_closure ? summary.all_pairs_optimized : summary.all_pairs_odometry);
+    j["relative_error_all_pairs_odometry"] = error_json(summary.all_pairs_odometry);
   }
   if (summary.map_agreement >= 0) j["map_agreement"] = summary.map_agreement;
   if (summary.map_agreement_odometry >= 0)

@@ -54,6 +54,8 @@ struct Map2DSummary {
   /// SE(2)-aligned absolute error against the reference: of the odometry, and of the optimized
   /// poses when loop closure ran.
   AbsoluteError2D ate_odometry, ate_optimized;
+  /// The relative error over all pairs of poses (all_pairs_relative_error_2d), likewise.
+  RelativeError2D all_pairs_odometry, all_pairs_optimized;
   bool loop_closure = false;
   LoopClosure2DCounts loops;
   std::size_t accepted_loops = 0;  ///< verified loop edges not judged outliers at the end
