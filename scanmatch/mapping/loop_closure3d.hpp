@@ -166,6 +166,11 @@ class LoopClosure3D {
   const PoseGraph3D& graph() const { return graph_; }
   /// Keyframe `k`'s submap (in its frame), as verification saw it.
   const PointCloud& submap(std::size_t keyframe) const { return keyframes_.at(keyframe).submap; }
+  std::size_t keyframes() const { return keyframes_.size(); }
+  /// The keyframe frame `index` belongs to (the last keyframe at or before it), and the frame's
+  /// odometry pose in that keyframe's frame: pose(index) == graph().pose(keyframe) * offset.
+  std::size_t keyframe_of(std::size_t index) const { return frame_keyframe_.at(index); }
+  const Pose& offset_in_keyframe(std::size_t index) const { return frame_offset_.at(index); }
 
  private:
   struct Keyframe {
