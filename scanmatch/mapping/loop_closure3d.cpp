@@ -266,16 +266,23 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
   bool added = false;
   for (const auto& [k, initial] : candidates) {
     ++counts_.candidates;
+    const Pose estimated = graph_.pose(k).inverse() * here;
+    const double allowed =
+        options_.max_correction +
+        options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
+    // A registration moves its start by a few metres at most: a start this far from the estimate
+    // cannot end within the gate below, so it is not worth verifying.
+    if ((estimated.translation() - initial.translation()).norm() >
+        allowed + options_.registration_reach) {
+      ++counts_.rejected_by_estimate;
+      continue;
+    }
     const LoopVerification3D v = verify_loop_3d(keyframes_[keyframe].submap, keyframes_[k].submap,
                                                 initial, options_.verification);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;
     }
-    const Pose estimated = graph_.pose(k).inverse() * here;
-    const double allowed =
-        options_.max_correction +
-        options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
     if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
       ++counts_.rejected_by_estimate;
       continue;

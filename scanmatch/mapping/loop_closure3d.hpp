@@ -114,6 +114,10 @@ struct LoopClosure3DOptions {
   /// most this base (m) plus this share of the odometry path between the two keyframes.
   double max_correction = 2.0;
   double max_correction_per_m = 0.05;
+  /// How far (m) verification can move a candidate from its start; a descriptor candidate whose
+  /// start (no translation) lies farther than the gate plus this from the estimate is rejected by
+  /// the estimate without being verified (the same answer, without the registration's cost).
+  double registration_reach = 8.0;
   /// Loop edges are looked for at every this-many keyframes (1: each one).
   std::size_t search_every = 1;
   LoopVerification3DOptions verification;
@@ -135,7 +139,8 @@ struct LoopClosure3DCounts {
   std::size_t candidates = 0;  ///< candidate pairs proposed (after merging both sources)
   std::size_t verified = 0;    ///< candidates that passed every check (loop edges added)
   std::size_t rejected_by_verification = 0;
-  /// Verified but too far from the current estimate (max_correction): not added.
+  /// Too far from the current estimate (max_correction), verified or (registration_reach) not
+  /// even worth verifying: not added.
   std::size_t rejected_by_estimate = 0;
   std::size_t outliers = 0;  ///< loop edges the graph judged outliers at its last optimize()
   std::size_t optimizations = 0;

@@ -143,12 +143,17 @@ class KeyframeClouds {
   std::vector<PointCloud> clouds_;
 };
 
-nlohmann::ordered_json loops_json(const std::vector<Loop3D>& loops) {
+// The accepted loops, each relative pose between the two frames' reported poses (as poses.txt
+// gives them, the frame start): loop closure measured it between their registration poses.
+nlohmann::ordered_json loops_json(const std::vector<Loop3D>& loops,
+                                  const std::vector<Pose>& reported_from_registered) {
   nlohmann::ordered_json j = nlohmann::ordered_json::array();
   for (const Loop3D& l : loops) {
     if (l.outlier) continue;
-    const Eigen::Matrix<double, 6, 1> xyz_rpy = to_xyz_rpy(l.relative);
-    const std::array<double, 12> row = to_kitti_row(l.relative);
+    const Pose relative = orthonormalized(reported_from_registered.at(l.from_frame).inverse() *
+                                          l.relative * reported_from_registered.at(l.to_frame));
+    const Eigen::Matrix<double, 6, 1> xyz_rpy = to_xyz_rpy(relative);
+    const std::array<double, 12> row = to_kitti_row(relative);
     j.push_back({{"from", l.from_frame},
                  {"to", l.to_frame},
                  {"from_keyframe", l.from_keyframe},
@@ -318,7 +323,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       optimized.timestamps = summary.timestamps;
       write_trajectory_atomic(dir + "/poses_optimized.txt", optimized, TrajectoryFormat::kKitti);
       write_trajectory_atomic(dir + "/poses_optimized_tum.txt", optimized, TrajectoryFormat::kTum);
-      write_file_atomic(dir + "/loops.json", loops_json(loop_closure->loops()).dump(2) + "\n");
+      write_file_atomic(dir + "/loops.json",
+                        loops_json(loop_closure->loops(), reported_from_registered).dump(2) + "\n");
     }
     write_ground_truth(dir, truth, summary);
     nlohmann::ordered_json j = {{"method", summary.method},

@@ -17,7 +17,8 @@
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
 // With loop closure (RunOptions::loop_closure; mapping/loop_closure3d.hpp) also, at the end:
 //   poses_optimized.txt, poses_optimized_tum.txt   the loop-closed poses (KITTI, TUM rows)
-//   loops.json      the accepted loop edges: frames, keyframes, relative pose, overlap, error
+//   loops.json      the accepted loop edges: frames, keyframes, the relative pose of the two
+//                   frames' poses as poses.txt gives them, overlap, error
 //   map.pcd/.ply    on request, rebuilt from the loop-closed poses; the odometry's map becomes
 //                   map_odometry.pcd/.ply
 //   summary.json    gains "loop_closure" (counts, ms per frame), "ate" becomes the loop-closed
