@@ -314,8 +314,19 @@ PoseGraph3D::Information LoopClosure3D::loop_information(const Matrix6d& hessian
   if (!(strongest > 0.0)) return fallback;
   // Keep the shape, set the scale; floor the eigenvalues so that the graph gets a positive
   // definite matrix even for a direction the geometry leaves free.
-  const Matrix6d scaled =
+  Matrix6d scaled =
       H / (strongest * options_.loop_sigma_translation * options_.loop_sigma_translation);
+  // The rotation block at that scale claims the points' lever arm (tens of metres) worth of
+  // certainty, a small fraction of a degree; submaps built from odometry poses are not that good.
+  // Its best direction is capped at loop_sigma_rotation (rows and columns scaled alike, so the
+  // matrix stays positive semi-definite).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rotation(scaled.bottomRightCorner<3, 3>());
+  const double rotation_cap = 1.0 / (options_.loop_sigma_rotation * options_.loop_sigma_rotation);
+  if (rotation.eigenvalues()(2) > rotation_cap) {
+    Vector6d d = Vector6d::Ones();
+    d.tail<3>().setConstant(std::sqrt(rotation_cap / rotation.eigenvalues()(2)));
+    scaled = d.asDiagonal() * scaled * d.asDiagonal();
+  }
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(scaled);
   if (eigen.info() != Eigen::Success) return fallback;
   const double floor = 1e-6 * eigen.eigenvalues().maxCoeff();
