@@ -253,30 +253,35 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
     }
   }
   if (options_.max_descriptor_candidates > 0) {
-    const auto found = places_.query(places_.at(keyframe), options_.skip_recent + 1,
-                                     options_.max_descriptor_candidates);
+    // Look-alike places often match better than the true one: the best few matches are looked
+    // at, those the estimate rules out dropped, and the best remaining ones verified.
+    const auto found =
+        places_.query(places_.at(keyframe), options_.skip_recent + 1,
+                      std::max(options_.descriptor_matches, options_.max_descriptor_candidates));
+    std::size_t taken = 0;
     for (const PlaceCandidate& c : found) {
+      if (taken >= options_.max_descriptor_candidates) break;
       if (c.distance > options_.max_descriptor_distance || c.index >= last_candidate) continue;
       const bool known = std::any_of(candidates.begin(), candidates.end(),
                                      [&](const auto& p) { return p.first == c.index; });
-      // The descriptor knows the yaw only: the coarse registration finds the translation.
-      if (!known) candidates.emplace_back(c.index, from_xyz_rpy(0, 0, 0, 0, 0, c.yaw));
+      if (known) continue;
+      // The descriptor knows the yaw only: the coarse registration finds the translation. A
+      // registration moves its start by a few metres at most, so a start this far from the
+      // estimate could not end within its gate (close_loops' check after verification).
+      const double distance = (graph_.pose(c.index).translation() - here.translation()).norm();
+      if (distance > correction_allowed(keyframe, c.index) + options_.registration_reach) {
+        ++counts_.ruled_out_by_estimate;
+        continue;
+      }
+      candidates.emplace_back(c.index, from_xyz_rpy(0, 0, 0, 0, 0, c.yaw));
+      ++taken;
     }
   }
   bool added = false;
   for (const auto& [k, initial] : candidates) {
     ++counts_.candidates;
     const Pose estimated = graph_.pose(k).inverse() * here;
-    const double allowed =
-        options_.max_correction +
-        options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
-    // A registration moves its start by a few metres at most: a start this far from the estimate
-    // cannot end within the gate below, so it is not worth verifying.
-    if ((estimated.translation() - initial.translation()).norm() >
-        allowed + options_.registration_reach) {
-      ++counts_.rejected_by_estimate;
-      continue;
-    }
+    const double allowed = correction_allowed(keyframe, k);
     const LoopVerification3D v = verify_loop_3d(keyframes_[keyframe].submap, keyframes_[k].submap,
                                                 initial, options_.verification);
     if (!v.accepted) {
@@ -302,6 +307,11 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
     added = true;
   }
   if (added) optimize();
+}
+
+double LoopClosure3D::correction_allowed(std::size_t keyframe, std::size_t candidate) const {
+  return options_.max_correction +
+         options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[candidate].path);
 }
 
 PoseGraph3D::Information LoopClosure3D::loop_information(const Matrix6d& hessian) const {

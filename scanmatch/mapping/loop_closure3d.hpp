@@ -108,17 +108,20 @@ struct LoopClosure3DOptions {
   /// current estimate, nearest first, at most `max_proximity_candidates` (0: none).
   double proximity_radius = 8.0;
   std::size_t max_proximity_candidates = 2;
-  /// Place-database candidates below this descriptor distance, at most this many (0: none).
+  /// Place-database candidates below this descriptor distance, at most this many (0: none),
+  /// taken from its best `descriptor_matches` matches: those the estimate rules out (below) are
+  /// skipped, since look-alike places often match better than the true one.
   double max_descriptor_distance = 0.3;
   std::size_t max_descriptor_candidates = 1;
+  std::size_t descriptor_matches = 5;
   /// Repeated structure verifies perfectly at the wrong place, so a verified loop must also agree
   /// with the current estimate: its translation may differ from the estimate's relative pose by at
   /// most this base (m) plus this share of the odometry path between the two keyframes.
   double max_correction = 2.0;
   double max_correction_per_m = 0.05;
-  /// How far (m) verification can move a candidate from its start; a descriptor candidate whose
-  /// start (no translation) lies farther than the gate plus this from the estimate is rejected by
-  /// the estimate without being verified (the same answer, without the registration's cost).
+  /// How far (m) verification can move a candidate from its start: a descriptor match whose
+  /// start (no translation) lies farther than the gate plus this from the estimate is ruled out
+  /// without being verified (verified, it could only be rejected by the gate).
   double registration_reach = 8.0;
   /// Loop edges are looked for at every this-many keyframes (1: each one).
   std::size_t search_every = 1;
@@ -141,9 +144,10 @@ struct LoopClosure3DCounts {
   std::size_t candidates = 0;  ///< candidate pairs proposed (after merging both sources)
   std::size_t verified = 0;    ///< candidates that passed every check (loop edges added)
   std::size_t rejected_by_verification = 0;
-  /// Too far from the current estimate (max_correction), verified or (registration_reach) not
-  /// even worth verifying: not added.
+  /// Verified but too far from the current estimate (max_correction): not added.
   std::size_t rejected_by_estimate = 0;
+  /// Place-database matches ruled out before verification (registration_reach); not candidates.
+  std::size_t ruled_out_by_estimate = 0;
   std::size_t outliers = 0;  ///< loop edges the graph judged outliers at its last optimize()
   std::size_t optimizations = 0;
   double total_ms = 0.0;  ///< wall time spent in add_frame() and finish()
@@ -194,6 +198,8 @@ class LoopClosure3D {
   void close_loops(std::size_t keyframe);
   void optimize();
   PoseGraph3D::Information loop_information(const Matrix6d& hessian) const;
+  /// The estimate gate (m) between a keyframe and an older candidate.
+  double correction_allowed(std::size_t keyframe, std::size_t candidate) const;
 
   LoopClosure3DOptions options_;
   PoseGraph3D graph_;
