@@ -97,9 +97,10 @@ struct LoopClosure3DOptions {
   /// direction has this standard deviation (m): the Hessian's shape says which directions the
   /// geometry pins down, but its scale (thousands of points, GICP's thin plane covariances) would
   /// claim sub-millimetre certainty. Its rotation block's best direction is capped at
-  /// `loop_sigma_rotation` (rad): the lever arm of far points would claim a small fraction of a
-  /// degree, and 33 loops each 0.2-0.4 deg off bent a simulated loop's heights by 0.2 m. Without
-  /// a usable Hessian (not finite or not positive definite), the fixed diagonal of both sigmas.
+  /// `loop_sigma_rotation` (rad): at that scale the lever arm of far points would claim a small
+  /// fraction of a degree, more than submaps built from odometry poses hold (a guard: on the
+  /// simulated campus loop the cap changed nothing measurable). Without a usable Hessian (not
+  /// finite or no positive translation eigenvalue), the fixed diagonal of both sigmas.
   double loop_sigma_translation = 0.05;
   double loop_sigma_rotation = 0.5 * M_PI / 180;
   /// The newest keyframes are never candidates (they are trivially the same place).
