@@ -205,7 +205,9 @@ bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pos
     places_.add(make_place_descriptor(k.submap, options_.descriptor));
     keyframes_.push_back(std::move(k));
     ++counts_.keyframes;
-    if (index % options_.search_every == 0) close_loops(index);
+    const bool pausing =
+        !loops_.empty() && index <= last_loop_keyframe_ + options_.keyframes_between_loops;
+    if (index % options_.search_every == 0 && !pausing) close_loops(index);
   }
   frame_keyframe_.push_back(keyframes_.size() - 1);
   frame_offset_.push_back(keyframes_.back().odometry.inverse() * odometry);
@@ -306,7 +308,10 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
     loops_.push_back(loop);
     added = true;
   }
-  if (added) optimize();
+  if (added) {
+    last_loop_keyframe_ = keyframe;
+    optimize();
+  }
 }
 
 double LoopClosure3D::correction_allowed(std::size_t keyframe, std::size_t candidate) const {

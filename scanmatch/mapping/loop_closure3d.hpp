@@ -124,8 +124,12 @@ struct LoopClosure3DOptions {
   /// start (no translation) lies farther than the gate plus this from the estimate is ruled out
   /// without being verified (verified, it could only be rejected by the gate).
   double registration_reach = 8.0;
-  /// Loop edges are looked for at every this-many keyframes (1: each one).
+  /// Loop edges are looked for at every this-many keyframes (1: each one) ...
   std::size_t search_every = 1;
+  /// ... and not at the next this-many keyframes after one that added a loop edge: on a second
+  /// pass every keyframe revisits a place, and one loop every few metres holds the graph as well
+  /// as one per keyframe at a fraction of the verification cost (0: no pause).
+  std::size_t keyframes_between_loops = 4;
   LoopVerification3DOptions verification;
   PlaceDescriptorOptions descriptor;
   PoseGraphConfig graph;
@@ -211,6 +215,7 @@ class LoopClosure3D {
   std::vector<Pose> frame_offset_;           ///< per frame, its pose in its keyframe's frame
   std::vector<std::size_t> loop_edges_;      ///< graph edge index of each loops_ entry
   std::vector<Loop3D> loops_;
+  std::size_t last_loop_keyframe_ = 0;  ///< the last keyframe that added a loop edge
   LoopClosure3DCounts counts_;
 };
 
