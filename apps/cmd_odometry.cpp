@@ -64,7 +64,19 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
                 summary.stage("fine").mean_ms, summary.stage("map_update").mean_ms);
     if (summary.bridged_frames > 0)
       std::printf("%zu frames bridged by the motion prior\n", summary.bridged_frames);
-    if (!accuracy.empty()) std::printf("%s\n", accuracy.c_str());
+    if (!accuracy.empty())
+      std::printf("%s%s\n", accuracy.c_str(), summary.loop_closure ? " (odometry)" : "");
+    if (summary.loop_closure) {
+      const LoopClosure3DCounts& l = summary.loops;
+      std::printf(
+          "loop closure: %zu keyframes, %zu candidates, %zu verified, %zu accepted (%zu "
+          "outliers), %.2f ms per frame\n",
+          l.keyframes, l.candidates, l.verified, summary.accepted_loops, l.outliers,
+          summary.loop_ms_per_frame);
+      if (const auto& ate = summary.ate_optimized; ate && ate->path_length > 0.0)
+        std::printf("ATE loop-closed %.3f m RMSE, %.3f %% of the %.1f m path\n", ate->rmse,
+                    ate->rmse_percent_of_path, ate->path_length);
+    }
     std::printf("results in %s\n", c.out.c_str());
   }
   if (summary.interrupted) throw CLI::RuntimeError(130);

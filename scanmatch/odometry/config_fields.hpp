@@ -182,6 +182,9 @@ void describe(RunOptions& r, Visitor& v) {
 template <typename Visitor>
 void describe(OdometryRunConfig& c, Visitor& v) {
   describe(c.odometry, v);
+  v("loop_closure", c.output.loop_closure, "--loop-closure",
+    "3D loop closure: a pose graph over keyframes, verified loops, poses_optimized*.txt, "
+    "loops.json, map.* from the optimized poses");
   v.nested("map_export", c.output);
 }
 

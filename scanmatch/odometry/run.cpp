@@ -1,13 +1,16 @@
 #include "scanmatch/odometry/run.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/eval/metrics_json.hpp"
+#include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/geometry/voxel_hash.hpp"
 #include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
@@ -103,6 +106,79 @@ void write_ground_truth(const std::string& dir, const std::optional<Trajectory>&
   if (gt.has_timestamps()) write_trajectory(dir + "/poses_gt_tum.txt", gt, TrajectoryFormat::kTum);
 }
 
+// The registered frames gathered per loop-closure keyframe (in the keyframe's frame, downsampled
+// to the exported map's voxel), so that the map can be rebuilt from the optimized keyframe poses.
+// Memory grows with the keyframes, each holding about one view at the map's voxel.
+class KeyframeClouds {
+ public:
+  explicit KeyframeClouds(double voxel) : voxel_(voxel) {}
+  void add(std::size_t keyframe, const PointCloud& frame, const Pose& keyframe_from_frame) {
+    if (keyframe >= clouds_.size()) {
+      settle();
+      clouds_.resize(keyframe + 1);
+    }
+    PointCloud& cloud = clouds_[keyframe];
+    const Eigen::Isometry3f T = keyframe_from_frame.cast<float>();
+    for (const Point& p : frame.points) cloud.points.push_back(T * p);
+    if (cloud.size() > 4 * kSettleEvery) settle();
+  }
+  /// The map of every keyframe's cloud placed at `keyframe_pose(k)`.
+  template <class PoseOf>
+  void add_to(PointMap& map, PoseOf keyframe_pose) {
+    settle();
+    for (std::size_t k = 0; k < clouds_.size(); ++k) map.add(clouds_[k], keyframe_pose(k));
+  }
+
+ private:
+  static constexpr std::size_t kSettleEvery = 50000;
+  void settle() {
+    if (clouds_.empty()) return;
+    try {
+      clouds_.back() = voxel_downsample(clouds_.back(), voxel_);
+    } catch (const Error&) {
+      // a coordinate beyond the voxel index range: keep the points undownsampled
+    }
+  }
+  double voxel_;
+  std::vector<PointCloud> clouds_;
+};
+
+// The accepted loops, each relative pose between the two frames' reported poses (as poses.txt
+// gives them, the frame start): loop closure measured it between their registration poses.
+nlohmann::ordered_json loops_json(const std::vector<Loop3D>& loops,
+                                  const std::vector<Pose>& reported_from_registered) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::array();
+  for (const Loop3D& l : loops) {
+    if (l.outlier) continue;
+    const Pose relative = orthonormalized(reported_from_registered.at(l.from_frame).inverse() *
+                                          l.relative * reported_from_registered.at(l.to_frame));
+    const Eigen::Matrix<double, 6, 1> xyz_rpy = to_xyz_rpy(relative);
+    const std::array<double, 12> row = to_kitti_row(relative);
+    j.push_back({{"from", l.from_frame},
+                 {"to", l.to_frame},
+                 {"from_keyframe", l.from_keyframe},
+                 {"to_keyframe", l.to_keyframe},
+                 {"x", xyz_rpy(0)},
+                 {"y", xyz_rpy(1)},
+                 {"z", xyz_rpy(2)},
+                 {"roll", xyz_rpy(3)},
+                 {"pitch", xyz_rpy(4)},
+                 {"yaw", xyz_rpy(5)},
+                 {"kitti_row", row},
+                 {"overlap", l.overlap},
+                 {"error_m", l.error}});
+  }
+  return j;
+}
+
+void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
+                             TrajectoryFormat format) {
+  write_trajectory(path + ".tmp", trajectory, format);
+  std::error_code ec;
+  std::filesystem::rename(path + ".tmp", path, ec);
+  if (ec) fail(path, "cannot replace the file: " + ec.message());
+}
+
 }  // namespace
 
 const StageStatistics& RunSummary::stage(std::string_view name) const {
@@ -138,6 +214,14 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   const std::size_t total =
       options.max_frames > 0 ? std::min(options.max_frames, source.size()) : source.size();
   PointMap map(options.map_voxel_size);
+  summary.loop_closure = options.loop_closure;
+  std::optional<LoopClosure3D> loop_closure;
+  if (options.loop_closure) loop_closure.emplace(options.loop);
+  KeyframeClouds keyframe_clouds(options.map_voxel_size);
+  // Per frame, its reported pose in the frame of the pose its points were registered at (the
+  // pipeline reports the frame start, registers at mid-frame): the loop-closed reported pose is
+  // the loop-closed registration pose followed by it.
+  std::vector<Pose> reported_from_registered;
   ProgressReporter progress("odometry " + config.method, total, "frames", options.quiet);
   Frame frame;
   double pipeline_ms = 0.0;
@@ -173,9 +257,21 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     // A bridged frame has no registered points of its own (an empty frame leaves the previous
     // one in last_frame()); it would only add a copy or a guess to the map.
     Pose world_from_frame;
-    const PointCloud* map_frame =
-        options.write_map && !s.bridged ? odometry->last_map_frame(world_from_frame) : nullptr;
-    if (map_frame != nullptr) {
+    const PointCloud* map_frame = (options.write_map || loop_closure) && !s.bridged
+                                      ? odometry->last_map_frame(world_from_frame)
+                                      : nullptr;
+    if (loop_closure) {
+      // A bridged frame (or a method that keeps no points) adds its pose only.
+      const Pose registered = map_frame != nullptr ? world_from_frame : pose;
+      loop_closure->add_frame(map_frame != nullptr ? *map_frame : PointCloud{}, registered);
+      reported_from_registered.push_back(registered.inverse() * pose);
+      if (map_frame != nullptr && options.write_map) {
+        const std::size_t index = loop_closure->frames() - 1;
+        keyframe_clouds.add(loop_closure->keyframe_of(index), *map_frame,
+                            loop_closure->offset_in_keyframe(index));
+      }
+    }
+    if (map_frame != nullptr && options.write_map) {
       map.add(*map_frame, world_from_frame);
       if (options.map_export_radius > 0.0 && summary.frames % 50 == 0)
         map.keep_within(pose.translation(), options.map_export_radius);
@@ -187,12 +283,48 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   summary.stages = stage_statistics(summary.stats);
   summary.frames_per_second = pipeline_ms > 0.0 ? 1000.0 * summary.frames / pipeline_ms : 0.0;
   evaluate(truth, summary);
+  if (loop_closure) {
+    loop_closure->finish();
+    summary.loops = loop_closure->counts();
+    for (std::size_t i = 0; i < loop_closure->frames(); ++i)
+      summary.optimized_poses.push_back(
+          orthonormalized(loop_closure->pose(i) * reported_from_registered[i]));
+    for (const Loop3D& l : loop_closure->loops()) summary.accepted_loops += !l.outlier;
+    if (summary.frames > 0)
+      summary.loop_ms_per_frame = summary.loops.total_ms / static_cast<double>(summary.frames);
+    if (!summary.ground_truth.empty())
+      summary.ate_optimized = compute_ate(
+          summary.ground_truth,
+          std::vector<Pose>(summary.optimized_poses.begin(),
+                            summary.optimized_poses.begin() +
+                                static_cast<std::ptrdiff_t>(summary.ground_truth.size())));
+  }
 
   if (write) {
     if (options.write_map) {
       if (options.map_export_radius > 0.0 && !summary.poses.empty())
         map.keep_within(summary.poses.back().translation(), options.map_export_radius);
-      write_cloud(dir + "/map." + options.map_format, map.cloud());
+      // map.* is the best map there is: the loop-closed one with loop closure.
+      write_cloud(dir + (loop_closure ? "/map_odometry." : "/map.") + options.map_format,
+                  map.cloud());
+      if (loop_closure) {
+        PointMap optimized_map(options.map_voxel_size);
+        keyframe_clouds.add_to(optimized_map,
+                               [&](std::size_t k) { return loop_closure->graph().pose(k); });
+        if (options.map_export_radius > 0.0 && !summary.optimized_poses.empty())
+          optimized_map.keep_within(summary.optimized_poses.back().translation(),
+                                    options.map_export_radius);
+        write_cloud(dir + "/map." + options.map_format, optimized_map.cloud());
+      }
+    }
+    if (loop_closure) {
+      Trajectory optimized;
+      optimized.poses = summary.optimized_poses;
+      optimized.timestamps = summary.timestamps;
+      write_trajectory_atomic(dir + "/poses_optimized.txt", optimized, TrajectoryFormat::kKitti);
+      write_trajectory_atomic(dir + "/poses_optimized_tum.txt", optimized, TrajectoryFormat::kTum);
+      write_file_atomic(dir + "/loops.json",
+                        loops_json(loop_closure->loops(), reported_from_registered).dump(2) + "\n");
     }
     write_ground_truth(dir, truth, summary);
     nlohmann::ordered_json j = {{"method", summary.method},
@@ -205,7 +337,24 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                 {"threads", config.threads},
                                 {"stages", stages_json(summary.stages)},
                                 {"health", health_json(summary.stats)}};
-    if (summary.ate) j["ate"] = ate_json(*summary.ate);
+    if (summary.ate) {
+      j["ate"] = ate_json(summary.ate_optimized ? *summary.ate_optimized : *summary.ate);
+      if (loop_closure) j["ate_odometry"] = ate_json(*summary.ate);
+    }
+    if (loop_closure) {
+      const LoopClosure3DCounts& c = summary.loops;
+      j["loop_closure"] = {{"keyframes", c.keyframes},
+                           {"candidates", c.candidates},
+                           {"verified", c.verified},
+                           {"rejected_by_verification", c.rejected_by_verification},
+                           {"rejected_by_estimate", c.rejected_by_estimate},
+                           {"ruled_out_by_estimate", c.ruled_out_by_estimate},
+                           {"rejected_as_outliers", c.outliers},
+                           {"accepted", summary.accepted_loops},
+                           {"optimizations", c.optimizations},
+                           {"total_ms", c.total_ms},
+                           {"ms_per_frame", summary.loop_ms_per_frame}};
+    }
     j["options"] = nlohmann::ordered_json::parse(odometry_config_to_json(config));
     write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");
   }

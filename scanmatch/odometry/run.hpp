@@ -15,6 +15,14 @@
 //   config.json     the OdometryConfig used and the map export options (reloadable with
 //                   --config; scanmatch/odometry/config_io.hpp)
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
+// With loop closure (RunOptions::loop_closure; mapping/loop_closure3d.hpp) also, at the end:
+//   poses_optimized.txt, poses_optimized_tum.txt   the loop-closed poses (KITTI, TUM rows)
+//   loops.json      the accepted loop edges: frames, keyframes, the relative pose of the two
+//                   frames' poses as poses.txt gives them, overlap, error
+//   map.pcd/.ply    on request, rebuilt from the loop-closed poses; the odometry's map becomes
+//                   map_odometry.pcd/.ply
+//   summary.json    gains "loop_closure" (counts, ms per frame), "ate" becomes the loop-closed
+//                   poses' and "ate_odometry" the odometry's
 // Per-frame files are appended and flushed frame by frame, so an interrupted run keeps its frames.
 // Timing covers the pipeline only (register_frame), never reading or simulating the frames.
 
@@ -27,6 +35,7 @@
 
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/sequence.hpp"
+#include "scanmatch/mapping/loop_closure3d.hpp"
 #include "scanmatch/odometry/odometry.hpp"
 
 namespace scanmatch {
@@ -38,7 +47,11 @@ struct RunOptions {
   std::string map_format = "pcd";  ///< "pcd" or "ply"
   double map_voxel_size = 0.1;     ///< m, downsampling of the exported map
   double map_export_radius = 0.0;  ///< m around the last pose; 0: unbounded (the whole run)
-  bool quiet = false;              ///< no progress line
+  /// A pose graph over keyframes with verified loop edges (mapping/loop_closure3d.hpp), fed each
+  /// registered frame; writes the loop-closed poses, loops.json and the map from them.
+  bool loop_closure = false;
+  LoopClosure3DOptions loop;  ///< its settings (library only; not in config.json)
+  bool quiet = false;         ///< no progress line
   /// Set to true (e.g. from a SIGINT handler) to stop after the current frame; the run then
   /// finishes its files and reports interrupted = true.
   const std::atomic<bool>* stop = nullptr;
@@ -61,6 +74,14 @@ struct RunSummary {
   /// ATE of `poses` against `ground_truth`, unaligned (both start at the identity, as the run
   /// does); absent without ground truth or frames.
   std::optional<AteResult> ate;
+  /// With loop closure: its counts, the loop-closed poses per frame, their ATE (like `ate`), the
+  /// accepted loops (not judged outliers at the end) and the wall time it added per frame.
+  bool loop_closure = false;
+  LoopClosure3DCounts loops;
+  std::vector<Pose> optimized_poses;
+  std::optional<AteResult> ate_optimized;
+  std::size_t accepted_loops = 0;
+  double loop_ms_per_frame = 0.0;
 
   /// The stage named `name` in frame_stats.hpp ("total"); throws std::out_of_range for others.
   const StageStatistics& stage(std::string_view name) const;

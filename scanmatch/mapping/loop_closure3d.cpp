@@ -1,0 +1,381 @@
+#include "scanmatch/mapping/loop_closure3d.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <utility>
+
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/covariance.hpp"
+#include "scanmatch/geometry/kdtree.hpp"
+#include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/registration/methods.hpp"
+
+namespace scanmatch {
+namespace {
+
+constexpr int kNormalNeighbours = 10;
+
+bool finite_cloud(const PointCloud& cloud) {
+  return std::all_of(cloud.points.begin(), cloud.points.end(),
+                     [](const Point& p) { return p.allFinite(); });
+}
+
+struct OverlapCheck {
+  double overlap = 0.0, error = 0.0;
+  Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();  ///< sum of n n^T over the paired points
+};
+
+// `from`'s points moved by `T` against `onto` (its k-d tree and normals). A point pairs with its
+// nearest neighbour within `pair_distance` and counts when it lies within `plane_distance` of
+// that neighbour's tangent plane: downsampled clouds sample a surface at different spots, so the
+// plane distance, not the point distance, shows whether they agree.
+OverlapCheck check_overlap(const PointCloud& from, const PointCloud& onto, const KdTree& onto_tree,
+                           const std::vector<Eigen::Vector3d>& onto_normals, const Pose& T,
+                           double pair_distance, double plane_distance) {
+  OverlapCheck c;
+  const auto max_squared = static_cast<float>(pair_distance * pair_distance);
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  std::size_t agreeing = 0;
+  double sum = 0.0;
+  for (const Point& p : from.points) {
+    const Point q = R * p + t;
+    std::size_t index = 0;
+    float squared = 0.0f;
+    if (!onto_tree.nearest(q, max_squared, index, squared)) continue;
+    const Eigen::Vector3d& n = onto_normals[index];
+    const double distance = std::abs(n.dot((q - onto.points[index]).cast<double>()));
+    if (distance > plane_distance) continue;
+    ++agreeing;
+    sum += distance;
+    c.normals += n * n.transpose();
+  }
+  c.overlap =
+      static_cast<double>(agreeing) / static_cast<double>(std::max<std::size_t>(from.size(), 1));
+  c.error = agreeing > 0 ? sum / static_cast<double>(agreeing) : 1e9;
+  return c;
+}
+
+// The smallest eigenvalue of the normals' scatter, normalised to trace 1: the share the weakest
+// translation direction gets (1/3 when the surfaces face every way, 0 in a tunnel).
+double weakest_direction(const Eigen::Matrix3d& normals) {
+  const double trace = normals.trace();
+  if (!(trace > 0.0)) return 0.0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normals / trace);
+  return eigen.eigenvalues()(0);  // ascending
+}
+
+// The solver's tangent order is [rotation; translation]; the pose graph's is the reverse.
+Matrix6d to_graph_order(const Matrix6d& H) {
+  Eigen::PermutationMatrix<6> swap;
+  swap.indices() << 3, 4, 5, 0, 1, 2;
+  return swap * H * swap.transpose();
+}
+
+PoseGraph3D::Information diagonal_information(double sigma_translation, double sigma_rotation) {
+  Vector6d d;
+  d.head<3>().setConstant(1.0 / (sigma_translation * sigma_translation));
+  d.tail<3>().setConstant(1.0 / (sigma_rotation * sigma_rotation));
+  return d.asDiagonal();
+}
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+      .count();
+}
+
+// The cloud without non-finite points, downsampled (an empty cloud when even that fails, e.g. a
+// coordinate too far away for a voxel index).
+PointCloud clean_points(const PointCloud& cloud, double voxel) {
+  PointCloud positions;
+  positions.points = cloud.points;  // only positions are needed
+  remove_non_finite(positions);
+  try {
+    return voxel_downsample(positions, voxel);
+  } catch (const Error&) {
+    return {};
+  }
+}
+
+}  // namespace
+
+LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& candidate,
+                                  const Pose& initial, const LoopVerification3DOptions& options) {
+  LoopVerification3D out;
+  out.transform = initial;
+  const std::size_t min_points = std::max<std::size_t>(options.min_points, kNormalNeighbours + 1);
+  if (current.size() < min_points || candidate.size() < min_points || !finite_cloud(current) ||
+      !finite_cloud(candidate) || !is_valid_pose(initial.matrix(), 1e-6))
+    return out;
+  RegistrationOptions coarse;
+  coarse.method = options.coarse_method;
+  coarse.voxel_resolution = options.coarse_resolution;
+  coarse.solver.max_iterations = options.max_iterations;
+  RegistrationOptions fine;
+  fine.method = options.fine_method;
+  fine.max_correspondence_distance = options.fine_max_correspondence_distance;
+  fine.solver.max_iterations = options.max_iterations;
+  RegistrationResult result;
+  try {
+    const Pose start = register_clouds(current, candidate, coarse, initial).transform;
+    if (!is_valid_pose(start.matrix(), 1e-6)) return out;
+    result = register_clouds(current, candidate, fine, start);
+  } catch (const Error&) {
+    return out;  // too few usable points for a method: not verifiable, so not a loop
+  }
+  if (!is_valid_pose(result.transform.matrix(), 1e-6)) return out;
+  out.transform = result.transform;
+  if (result.information.allFinite()) out.hessian = to_graph_order(result.information);
+
+  const KdTree current_tree(current.points), candidate_tree(candidate.points);
+  const std::vector<Eigen::Vector3d> current_normals =
+      estimate_normals(current, current_tree, kNormalNeighbours);
+  const std::vector<Eigen::Vector3d> candidate_normals =
+      estimate_normals(candidate, candidate_tree, kNormalNeighbours);
+  const OverlapCheck forward =
+      check_overlap(current, candidate, candidate_tree, candidate_normals, out.transform,
+                    options.pair_distance, options.plane_distance);
+  OverlapCheck backward =
+      check_overlap(candidate, current, current_tree, current_normals, out.transform.inverse(),
+                    options.pair_distance, options.plane_distance);
+  // Both in the candidate's frame, so that the two ways' normals add up.
+  const Eigen::Matrix3d R = out.transform.linear();
+  backward.normals = R * backward.normals * R.transpose();
+  out.overlap = std::min(forward.overlap, backward.overlap);
+  out.error = std::max(forward.error, backward.error);
+  out.constraint = weakest_direction(forward.normals + backward.normals);
+  out.accepted = out.overlap >= options.min_overlap && out.error <= options.max_error &&
+                 out.constraint >= options.min_constraint;
+  return out;
+}
+
+LoopClosure3D::LoopClosure3D(const LoopClosure3DOptions& options)
+    : options_(options), graph_(options.graph) {
+  find_registration_method(options.verification.coarse_method);
+  find_registration_method(options.verification.fine_method);
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(options.odometry_sigma_translation) || !positive(options.odometry_sigma_rotation) ||
+      !positive(options.loop_sigma_translation) || !positive(options.loop_sigma_rotation))
+    throw Error("loop closure: the edge standard deviations must be positive");
+  if (!positive(options.submap_voxel) || !positive(options.verification.pair_distance) ||
+      !positive(options.verification.coarse_resolution))
+    throw Error("loop closure: submap voxel, pair distance and coarse resolution must be positive");
+  if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
+    throw Error("loop closure: keyframe thresholds must not be negative");
+  options_.search_every = std::max<std::size_t>(options_.search_every, 1);
+  options_.submap_frames = std::max<std::size_t>(options_.submap_frames, 1);
+}
+
+bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pose) {
+  const auto start = std::chrono::steady_clock::now();
+  // A non-finite or non-rigid odometry pose would poison the graph: hold the last one instead.
+  Pose odometry = odometry_pose;
+  if (!is_valid_pose(odometry.matrix(), 1e-3))
+    odometry =
+        keyframes_.empty() ? Pose::Identity() : keyframes_.back().odometry * frame_offset_.back();
+  odometry = orthonormalized(odometry);
+  recent_.push_back({clean_points(points, options_.submap_voxel), odometry});
+  while (recent_.size() > options_.submap_frames) recent_.pop_front();
+
+  bool new_keyframe = keyframes_.empty();
+  if (!new_keyframe) {
+    const Pose motion = keyframes_.back().odometry.inverse() * odometry;
+    new_keyframe = motion.translation().norm() >= options_.keyframe_distance ||
+                   rotation_angle(motion) >= options_.keyframe_angle;
+  }
+  if (new_keyframe) {
+    Keyframe k;
+    k.frame = frame_keyframe_.size();
+    k.submap = build_submap(odometry);
+    k.odometry = odometry;
+    const std::size_t index = keyframes_.size();
+    if (index == 0) {
+      graph_.add_node(odometry);
+    } else {
+      const Keyframe& previous = keyframes_.back();
+      const Pose measurement = orthonormalized(previous.odometry.inverse() * odometry);
+      k.path = previous.path + measurement.translation().norm();
+      graph_.add_node(orthonormalized(graph_.pose(index - 1) * measurement));
+      graph_.add_edge(index - 1, index, measurement,
+                      diagonal_information(options_.odometry_sigma_translation,
+                                           options_.odometry_sigma_rotation),
+                      EdgeKind::kOdometry);
+    }
+    places_.add(make_place_descriptor(k.submap, options_.descriptor));
+    keyframes_.push_back(std::move(k));
+    ++counts_.keyframes;
+    const bool pausing =
+        !loops_.empty() && index <= last_loop_keyframe_ + options_.keyframes_between_loops;
+    if (index % options_.search_every == 0 && !pausing) close_loops(index);
+  }
+  frame_keyframe_.push_back(keyframes_.size() - 1);
+  frame_offset_.push_back(keyframes_.back().odometry.inverse() * odometry);
+  counts_.total_ms += elapsed_ms(start);
+  return new_keyframe;
+}
+
+PointCloud LoopClosure3D::build_submap(const Pose& keyframe_odometry) const {
+  const Pose keyframe_inverse = keyframe_odometry.inverse();
+  PointCloud merged;
+  for (const RecentFrame& f : recent_) {
+    const Eigen::Isometry3f T = (keyframe_inverse * f.odometry).cast<float>();
+    for (const Point& p : f.points.points) merged.points.push_back(T * p);
+  }
+  PointCloud submap = clean_points(merged, options_.submap_voxel);
+  for (double voxel = 1.5 * options_.submap_voxel;
+       submap.size() > options_.max_submap_points && voxel < 100.0; voxel *= 1.5)
+    submap = clean_points(submap, voxel);
+  return submap;
+}
+
+void LoopClosure3D::close_loops(std::size_t keyframe) {
+  if (keyframe <= options_.skip_recent) return;
+  const std::size_t last_candidate = keyframe - options_.skip_recent;  // exclusive
+  const Pose here = graph_.pose(keyframe);
+  // Candidates with the relative pose each implies (current keyframe in the candidate's frame).
+  std::vector<std::pair<std::size_t, Pose>> candidates;
+  if (options_.max_proximity_candidates > 0) {
+    std::vector<std::pair<double, std::size_t>> near;
+    for (std::size_t k = 0; k < last_candidate; ++k) {
+      const double d = (graph_.pose(k).translation() - here.translation()).norm();
+      if (d <= options_.proximity_radius) near.emplace_back(d, k);
+    }
+    std::sort(near.begin(), near.end());
+    // Nearest first, but not several neighbours of one visit: they would verify the same loop.
+    std::vector<std::size_t> chosen;
+    for (const auto& [d, k] : near) {
+      if (chosen.size() >= options_.max_proximity_candidates) break;
+      const bool same_visit = std::any_of(chosen.begin(), chosen.end(), [&](std::size_t c) {
+        return (c > k ? c - k : k - c) < options_.skip_recent / 2 + 1;
+      });
+      if (same_visit) continue;
+      chosen.push_back(k);
+      candidates.emplace_back(k, orthonormalized(graph_.pose(k).inverse() * here));
+    }
+  }
+  if (options_.max_descriptor_candidates > 0) {
+    // Look-alike places often match better than the true one: the best few matches are looked
+    // at, those the estimate rules out dropped, and the best remaining ones verified.
+    const auto found =
+        places_.query(places_.at(keyframe), options_.skip_recent + 1,
+                      std::max(options_.descriptor_matches, options_.max_descriptor_candidates));
+    std::size_t taken = 0;
+    for (const PlaceCandidate& c : found) {
+      if (taken >= options_.max_descriptor_candidates) break;
+      if (c.distance > options_.max_descriptor_distance || c.index >= last_candidate) continue;
+      const bool known = std::any_of(candidates.begin(), candidates.end(),
+                                     [&](const auto& p) { return p.first == c.index; });
+      if (known) continue;
+      // The descriptor knows the yaw only: the coarse registration finds the translation. A
+      // registration moves its start by a few metres at most, so a start this far from the
+      // estimate could not end within its gate (close_loops' check after verification).
+      const double distance = (graph_.pose(c.index).translation() - here.translation()).norm();
+      if (distance > correction_allowed(keyframe, c.index) + options_.registration_reach) {
+        ++counts_.ruled_out_by_estimate;
+        continue;
+      }
+      candidates.emplace_back(c.index, from_xyz_rpy(0, 0, 0, 0, 0, c.yaw));
+      ++taken;
+    }
+  }
+  bool added = false;
+  for (const auto& [k, initial] : candidates) {
+    ++counts_.candidates;
+    const Pose estimated = graph_.pose(k).inverse() * here;
+    const double allowed = correction_allowed(keyframe, k);
+    const LoopVerification3D v = verify_loop_3d(keyframes_[keyframe].submap, keyframes_[k].submap,
+                                                initial, options_.verification);
+    if (!v.accepted) {
+      ++counts_.rejected_by_verification;
+      continue;
+    }
+    if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
+      ++counts_.rejected_by_estimate;
+      continue;
+    }
+    ++counts_.verified;
+    Loop3D loop;
+    loop.from_keyframe = k;
+    loop.to_keyframe = keyframe;
+    loop.from_frame = keyframes_[k].frame;
+    loop.to_frame = keyframes_[keyframe].frame;
+    loop.relative = orthonormalized(v.transform);
+    loop.overlap = v.overlap;
+    loop.error = v.error;
+    loop_edges_.push_back(
+        graph_.add_edge(k, keyframe, loop.relative, loop_information(v.hessian), EdgeKind::kLoop));
+    loops_.push_back(loop);
+    added = true;
+  }
+  if (added) {
+    last_loop_keyframe_ = keyframe;
+    optimize();
+  }
+}
+
+double LoopClosure3D::correction_allowed(std::size_t keyframe, std::size_t candidate) const {
+  return options_.max_correction +
+         options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[candidate].path);
+}
+
+PoseGraph3D::Information LoopClosure3D::loop_information(const Matrix6d& hessian) const {
+  const PoseGraph3D::Information fallback =
+      diagonal_information(options_.loop_sigma_translation, options_.loop_sigma_rotation);
+  if (!hessian.allFinite()) return fallback;
+  const Matrix6d H = 0.5 * (hessian + hessian.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> translation(H.topLeftCorner<3, 3>());
+  const double strongest = translation.eigenvalues()(2);
+  if (!(strongest > 0.0)) return fallback;
+  // Keep the shape, set the scale; floor the eigenvalues so that the graph gets a positive
+  // definite matrix even for a direction the geometry leaves free.
+  Matrix6d scaled =
+      H / (strongest * options_.loop_sigma_translation * options_.loop_sigma_translation);
+  // The rotation block at that scale claims the points' lever arm (tens of metres) worth of
+  // certainty, a small fraction of a degree; submaps built from odometry poses are not that good.
+  // Its best direction is capped at loop_sigma_rotation (rows and columns scaled alike, so the
+  // matrix stays positive semi-definite).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rotation(scaled.bottomRightCorner<3, 3>());
+  const double rotation_cap = 1.0 / (options_.loop_sigma_rotation * options_.loop_sigma_rotation);
+  if (rotation.eigenvalues()(2) > rotation_cap) {
+    Vector6d d = Vector6d::Ones();
+    d.tail<3>().setConstant(std::sqrt(rotation_cap / rotation.eigenvalues()(2)));
+    scaled = d.asDiagonal() * scaled * d.asDiagonal();
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(scaled);
+  if (eigen.info() != Eigen::Success) return fallback;
+  const double floor = 1e-6 * eigen.eigenvalues().maxCoeff();
+  const Vector6d values = eigen.eigenvalues().cwiseMax(floor);
+  if (!(floor > 0.0) || !values.allFinite()) return fallback;
+  const Matrix6d information =
+      eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
+  return 0.5 * (information + information.transpose());
+}
+
+void LoopClosure3D::optimize() {
+  const PoseGraphSummary s = graph_.optimize();
+  ++counts_.optimizations;
+  for (std::size_t i = 0; i < loops_.size(); ++i)
+    loops_[i].outlier = std::find(s.outlier_edges.begin(), s.outlier_edges.end(), loop_edges_[i]) !=
+                        s.outlier_edges.end();
+  counts_.outliers = s.outlier_edges.size();
+}
+
+void LoopClosure3D::finish() {
+  const auto start = std::chrono::steady_clock::now();
+  if (!loops_.empty()) optimize();
+  counts_.total_ms += elapsed_ms(start);
+}
+
+Pose LoopClosure3D::pose(std::size_t index) const {
+  return graph_.pose(frame_keyframe_.at(index)) * frame_offset_.at(index);
+}
+
+std::vector<Pose> LoopClosure3D::poses() const {
+  std::vector<Pose> out;
+  out.reserve(frames());
+  for (std::size_t i = 0; i < frames(); ++i) out.push_back(pose(i));
+  return out;
+}
+
+}  // namespace scanmatch
