@@ -11,7 +11,8 @@ as numpy arrays:
 * ``eval.ate(gt_poses, est_poses)`` / ``eval.rpe(...)``
 * 2D: ``register2d(current, reference, ...)`` and ``Mapper2D``
 * loop closure: ``LoopClosure2D(**options)`` with ``add_scan(points, odometry_pose)``, ``finish()``,
-  ``poses`` (optimized, N x 3 x 3) and ``loops``
+  ``poses`` (optimized, N x 3 x 3) and ``loops``; ``LoopClosure3D`` likewise with
+  ``add_frame(points, odometry_pose)`` and N x 4 x 4 poses
 
 Copies: arrays passed in are copied once into the library's layout (a ``PointCloud`` is used in
 place, so convert once for repeated use); clouds coming out (``read_cloud``, simulated frames)
@@ -34,6 +35,7 @@ from . import _scanmatch
 from ._scanmatch import (
     Error,
     LoopClosure2D,
+    LoopClosure3D,
     Mapper2D,
     Odometry,
     PointCloud,
@@ -41,6 +43,7 @@ from ._scanmatch import (
     RegistrationResult,
     Simulator,
     loop_closure_2d_options,
+    loop_closure_3d_options,
     mapper2d_options,
     odometry_options,
     presets,
@@ -58,14 +61,15 @@ from . import eval  # noqa: A004  (scanmatch.eval, as the CLI's `scanmatch eval`
 __version__ = _scanmatch.__version__
 
 # Shown as scanmatch.X in messages and reprs (they live in the compiled scanmatch._scanmatch).
-for _cls in (Error, LoopClosure2D, Mapper2D, Odometry, PointCloud, Registration2DResult, RegistrationResult,
-             Simulator):
+for _cls in (Error, LoopClosure2D, LoopClosure3D, Mapper2D, Odometry, PointCloud,
+             Registration2DResult, RegistrationResult, Simulator):
     _cls.__module__ = __name__
 del _cls
 
 __all__ = [
     "Error",
     "LoopClosure2D",
+    "LoopClosure3D",
     "Mapper2D",
     "Odometry",
     "PointCloud",
@@ -75,6 +79,7 @@ __all__ = [
     "Simulator",
     "eval",
     "loop_closure_2d_options",
+    "loop_closure_3d_options",
     "mapper2d_options",
     "odometry_methods",
     "odometry_options",

@@ -1,5 +1,6 @@
-// Loop closure (scanmatch/mapping/): LoopClosure2D over a 2D odometry. Scans are (N, 2) arrays
-// as Mapper2D takes them; poses 3x3 float64 copies.
+// Loop closure (scanmatch/mapping/): LoopClosure2D over a 2D odometry (scans are (N, 2) arrays as
+// Mapper2D takes them; poses 3x3 float64 copies) and LoopClosure3D over a 3D one (frames are
+// (N, 3) arrays or PointClouds; poses 4x4 float64 copies).
 
 #include <pybind11/stl.h>
 
@@ -7,6 +8,7 @@
 #include "convert.hpp"
 #include "options.hpp"
 #include "scanmatch/mapping/loop_closure2d.hpp"
+#include "scanmatch/mapping/loop_closure3d.hpp"
 
 namespace scanmatch::python {
 namespace {
@@ -21,6 +23,33 @@ py::dict loop_dict(const Loop2D& l) {
   d["paired_fraction"] = l.paired_fraction;
   d["error"] = l.error;
   d["outlier"] = l.outlier;
+  return d;
+}
+
+py::dict loop_dict(const Loop3D& l) {
+  py::dict d;
+  d["from_frame"] = l.from_frame;
+  d["to_frame"] = l.to_frame;
+  d["from_keyframe"] = l.from_keyframe;
+  d["to_keyframe"] = l.to_keyframe;
+  d["relative"] = pose_to_array(l.relative);
+  d["overlap"] = l.overlap;
+  d["error"] = l.error;
+  d["outlier"] = l.outlier;
+  return d;
+}
+
+py::dict counts_dict(const LoopClosure3DCounts& c) {
+  py::dict d;
+  d["keyframes"] = c.keyframes;
+  d["candidates"] = c.candidates;
+  d["verified"] = c.verified;
+  d["rejected_by_verification"] = c.rejected_by_verification;
+  d["rejected_by_estimate"] = c.rejected_by_estimate;
+  d["ruled_out_by_estimate"] = c.ruled_out_by_estimate;
+  d["outliers"] = c.outliers;
+  d["optimizations"] = c.optimizations;
+  d["total_ms"] = c.total_ms;
   return d;
 }
 
@@ -88,6 +117,67 @@ The next scan ((N, 2) x y in beam order, as registered) with its odometry pose (
           "counts", [](const LoopClosure2D& lc) { return counts_dict(lc.counts()); },
           "keyframes, candidates, verified, rejections, outliers, optimizations, total_ms")
       .def("__len__", &LoopClosure2D::scans);
+
+  py::class_<LoopClosure3D>(m, "LoopClosure3D", R"doc(
+LoopClosure3D(**options): 3D loop closure over a LiDAR odometry. Each frame comes with its odometry
+pose; keyframes (with a submap of their last frames) become nodes of a pose graph, candidates
+(nearby keyframes and place-descriptor matches) are verified with NDT then GICP, verified loops
+that agree with the estimate become edges and the graph is optimized. options: the fields of
+LoopClosure3DOptions (keyframe_distance, submap_frames, proximity_radius, verification={...},
+graph={...}, ...); loop_closure_3d_options() lists them.)doc")
+      .def(py::init([](py::kwargs kwargs) {
+        LoopClosure3DOptions options;
+        FieldTable table(options, "LoopClosure3D()");
+        table.apply(kwargs);
+        try {
+          return std::make_unique<LoopClosure3D>(options);
+        } catch (const Error& e) {
+          throw py::value_error(std::string("LoopClosure3D(): ") + e.what());
+        }
+      }))
+      .def(
+          "add_frame",
+          [](LoopClosure3D& lc, py::handle points, py::handle pose) {
+            std::optional<PointCloud> storage;
+            const PointCloud& cloud = cloud_argument(points, "points", storage);
+            const Pose odometry = pose_from_array(pose, "pose");
+            py::gil_scoped_release release;
+            return lc.add_frame(cloud, odometry);
+          },
+          py::arg("points"), py::arg("pose"), R"doc(
+add_frame(points, pose) -> bool
+
+The next frame ((N, 3) x y z in the sensor frame, deskewed and downsampled as registered, or a
+PointCloud) with its odometry pose (4x4). Returns True when it became a keyframe (and loops were
+looked for).)doc")
+      .def(
+          "finish", [](LoopClosure3D& lc) { lc.finish(); },
+          "Optimizes once more so that the outlier flags are current; call after the last frame")
+      .def_property_readonly(
+          "poses", [](const LoopClosure3D& lc) { return poses_to_array(lc.poses()); },
+          "(N, 4, 4) float64: every frame's optimized pose")
+      .def_property_readonly(
+          "loops",
+          [](const LoopClosure3D& lc) {
+            py::list out;
+            for (const Loop3D& l : lc.loops()) out.append(loop_dict(l));
+            return out;
+          },
+          "Accepted loop edges as dicts (from_frame, to_frame, relative 4x4, overlap, error m, "
+          "outlier)")
+      .def_property_readonly(
+          "counts", [](const LoopClosure3D& lc) { return counts_dict(lc.counts()); },
+          "keyframes, candidates, verified, rejections, outliers, optimizations, total_ms")
+      .def("__len__", &LoopClosure3D::frames);
+
+  m.def(
+      "loop_closure_3d_options",
+      [](bool help) {
+        LoopClosure3DOptions options;
+        FieldTable table(options, "loop_closure_3d_options()");
+        return help ? table.help() : table.values();
+      },
+      py::arg("help") = false, "Every keyword option of LoopClosure3D as {dotted key: default}");
 
   m.def(
       "loop_closure_2d_options",

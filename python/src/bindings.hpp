@@ -13,6 +13,6 @@ void bind_odometry(py::module_& m);      // Odometry
 void bind_simulator(py::module_& m);     // simulate, presets
 void bind_eval(py::module_& m);          // ate, rpe
 void bind_planar(py::module_& m);        // register2d, Mapper2D
-void bind_mapping(py::module_& m);       // LoopClosure2D
+void bind_mapping(py::module_& m);       // LoopClosure2D, LoopClosure3D
 
 }  // namespace scanmatch::python

@@ -1,4 +1,5 @@
-"""Loop closure: LoopClosure2D over a drifting odometry of simulated room-2d scans."""
+"""Loop closure over odometries that drift in a known way: LoopClosure2D on simulated room-2d
+scans, LoopClosure3D around the simulated campus block."""
 
 import unittest
 
@@ -31,7 +32,7 @@ def rmse(truth, estimate):
     return float(np.sqrt((((a - ca) @ rotation.T + cb - b) ** 2).sum(axis=1).mean()))
 
 
-class LoopClosure(unittest.TestCase):
+class LoopClosure2D(unittest.TestCase):
     def test_loop_closure_2d_removes_a_known_drift(self):
         sim = scanmatch.Simulator("room-2d", frames=500, seed=1, motion_distortion=False)
         truth = np.stack([planar_of(sim.pose(i)) for i in range(len(sim))])
@@ -81,3 +82,55 @@ class LoopClosure(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+def drifting(truth, yaw_per_m):
+    """Each true step 0.2 % too long and turned by a yaw bias per metre: an odometry that drifts."""
+    odometry = [truth[0]]
+    for i in range(1, len(truth)):
+        step = np.linalg.inv(truth[i - 1]) @ truth[i]
+        length = np.linalg.norm(step[:3, 3])
+        step[:3, 3] *= 1.002
+        yaw = yaw_per_m * length
+        turn = np.eye(4)
+        turn[:2, :2] = [[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]]
+        odometry.append(odometry[-1] @ step @ turn)
+    return np.stack(odometry)
+
+
+class LoopClosure3D(unittest.TestCase):
+    def test_loop_closure_3d_closes_the_campus_loop(self):
+        # dynamic-outdoor-fast: 1000 frames go once around the campus block; every second one.
+        sim = scanmatch.Simulator("dynamic-outdoor-fast", frames=1000, seed=1,
+                                  motion_distortion=False)
+        indices = range(0, len(sim), 2)
+        truth = np.stack([sim.pose(i) for i in indices])
+        odometry = drifting(truth, np.radians(0.01))
+        closure = scanmatch.LoopClosure3D()
+        for k, i in enumerate(indices):
+            closure.add_frame(sim.frame(i), odometry[k])
+        closure.finish()
+        self.assertEqual(closure.poses.shape, (len(truth), 4, 4))
+        before = scanmatch.eval.ate(truth, odometry)["rmse"]
+        after = scanmatch.eval.ate(truth, closure.poses)["rmse"]
+        self.assertGreater(before, 1.0)
+        self.assertLess(after, before / 3)
+        self.assertGreater(len(closure.loops), 0)
+        for loop in closure.loops:
+            if loop["outlier"]:
+                continue
+            expected = np.linalg.inv(truth[loop["from_frame"]]) @ truth[loop["to_frame"]]
+            self.assertLess(np.linalg.norm(loop["relative"][:3, 3] - expected[:3, 3]), 0.3)
+
+    def test_options_and_errors(self):
+        options = scanmatch.loop_closure_3d_options()
+        self.assertEqual(options["verification.fine_method"], "gicp")
+        with self.assertRaisesRegex(TypeError, "no_such_option"):
+            scanmatch.LoopClosure3D(no_such_option=1)
+        with self.assertRaisesRegex(ValueError, "LoopClosure3D"):
+            scanmatch.LoopClosure3D(verification={"fine_method": "no-such-method"})
+        closure = scanmatch.LoopClosure3D()
+        with self.assertRaisesRegex(ValueError, "non-finite|finite"):
+            closure.add_frame(np.array([[1.0, np.nan, 0.0]]), np.eye(4))
+        self.assertTrue(closure.add_frame(np.zeros((0, 3)), np.eye(4)))  # empty: kept, no loops
+        self.assertEqual(closure.poses.shape, (1, 4, 4))

@@ -186,6 +186,7 @@ void describe(OdometryRunConfig& c, Visitor& v) {
     "3D loop closure: a pose graph over keyframes, verified loops, poses_optimized*.txt, "
     "loops.json, map.* from the optimized poses");
   v.nested("map_export", c.output);
+  v.nested("loop", c.output.loop);
 }
 
 // `register`: the registration's own keys, and the downsampling of both clouds.
@@ -306,6 +307,79 @@ void describe(LoopVerification2DOptions& o, Visitor& v) {
 }
 
 template <typename Visitor>
+void describe(PlaceDescriptorOptions& o, Visitor& v) {
+  v("rings", o.rings, nullptr, "Place descriptor: rings of range");
+  v("sectors", o.sectors, nullptr, "Place descriptor: sectors of bearing");
+  v("max_range", o.max_range, nullptr, "Place descriptor: range of the outer ring, m");
+  v("height_offset", o.height_offset, nullptr, "Place descriptor: m added to z (sensor height)");
+}
+
+template <typename Visitor>
+void describe(PlaceDescriptor2DOptions& o, Visitor& v) {
+  v("rings", o.rings, nullptr, "Place descriptor: rings of range");
+  v("sectors", o.sectors, nullptr, "Place descriptor: sectors of bearing");
+  v("max_range", o.max_range, nullptr, "Place descriptor: range of the outer ring, m");
+}
+
+template <typename Visitor>
+void describe(LoopVerification3DOptions& o, Visitor& v) {
+  v("coarse_method", o.coarse_method, nullptr, "Registration method of the coarse stage");
+  v("coarse_resolution", o.coarse_resolution, nullptr, "Coarse stage's voxel grid, m");
+  v("fine_method", o.fine_method, nullptr, "Registration method of the fine stage");
+  v("fine_max_correspondence_distance", o.fine_max_correspondence_distance, nullptr,
+    "Fine stage's correspondence distance, m");
+  v("max_iterations", o.max_iterations, nullptr, "Iterations of each stage");
+  v("pair_distance", o.pair_distance, nullptr, "A point pairs with the nearest within this, m");
+  v("plane_distance", o.plane_distance, nullptr,
+    "A paired point agrees within this distance of the tangent plane, m");
+  v("min_overlap", o.min_overlap, nullptr, "Share of each submap that must agree");
+  v("max_error", o.max_error, nullptr, "Mean plane distance of the agreeing points, at most, m");
+  v("min_constraint", o.min_constraint, nullptr,
+    "The weakest translation direction's share of the normals, at least");
+  v("min_points", o.min_points, nullptr, "Points each submap needs to be verified");
+}
+
+template <typename Visitor>
+void describe(LoopClosure3DOptions& o, Visitor& v) {
+  v("keyframe_distance", o.keyframe_distance, nullptr, "New loop keyframe after this many m");
+  v("keyframe_angle", o.keyframe_angle, nullptr, "New loop keyframe after this many rad");
+  v("submap_frames", o.submap_frames, nullptr, "Frames in a keyframe's submap");
+  v("submap_voxel", o.submap_voxel, nullptr, "Submap voxel, m");
+  v("max_submap_points", o.max_submap_points, nullptr, "Submap points, at most");
+  v("odometry_sigma_translation", o.odometry_sigma_translation, nullptr,
+    "Odometry edge standard deviation, m");
+  v("odometry_sigma_rotation", o.odometry_sigma_rotation, nullptr,
+    "Odometry edge standard deviation, rad");
+  v("loop_sigma_translation", o.loop_sigma_translation, nullptr,
+    "Loop edge: the best translation direction's standard deviation, m");
+  v("loop_sigma_rotation", o.loop_sigma_rotation, nullptr,
+    "Loop edge: the best rotation direction's standard deviation, at least, rad");
+  v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
+  v("proximity_radius", o.proximity_radius, nullptr,
+    "Candidates within this distance in the current estimate, m");
+  v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
+    "Pose-proximity candidates per keyframe, at most");
+  v("max_descriptor_distance", o.max_descriptor_distance, nullptr,
+    "Place-database candidates below this descriptor distance");
+  v("max_descriptor_candidates", o.max_descriptor_candidates, nullptr,
+    "Place-database candidates per keyframe, at most");
+  v("descriptor_matches", o.descriptor_matches, nullptr,
+    "Place-database matches looked at per keyframe");
+  v("max_correction", o.max_correction, nullptr,
+    "A verified loop may move the estimate by this many m ...");
+  v("max_correction_per_m", o.max_correction_per_m, nullptr,
+    "... plus this share of the path between the two keyframes");
+  v("registration_reach", o.registration_reach, nullptr,
+    "How far verification can move a candidate, m");
+  v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
+  v("keyframes_between_loops", o.keyframes_between_loops, nullptr,
+    "Keyframes without a search after one that added a loop");
+  v.nested("verification", o.verification);
+  v.nested("descriptor", o.descriptor);
+  v.nested("graph", o.graph);
+}
+
+template <typename Visitor>
 void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("keyframe_distance", o.keyframe_distance, nullptr, "New loop keyframe after this many m");
   v("keyframe_angle", o.keyframe_angle, nullptr, "New loop keyframe after this many rad");
@@ -329,6 +403,7 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
     "... plus this share of the path between the two keyframes");
   v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
   v.nested("verification", o.verification);
+  v.nested("descriptor", o.descriptor);
   v.nested("graph", o.graph);
 }
 

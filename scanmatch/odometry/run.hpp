@@ -50,7 +50,7 @@ struct RunOptions {
   /// A pose graph over keyframes with verified loop edges (mapping/loop_closure3d.hpp), fed each
   /// registered frame; writes the loop-closed poses, loops.json and the map from them.
   bool loop_closure = false;
-  LoopClosure3DOptions loop;  ///< its settings (library only; not in config.json)
+  LoopClosure3DOptions loop;  ///< its settings (config.json's "loop")
   bool quiet = false;         ///< no progress line
   /// Set to true (e.g. from a SIGINT handler) to stop after the current frame; the run then
   /// finishes its files and reports interrupted = true.
