@@ -151,7 +151,7 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
 }
 
 LoopClosure3D::LoopClosure3D(const LoopClosure3DOptions& options)
-    : options_(options), graph_(options.graph) {
+    : options_(options), graph_(options.graph), frame_voxel_(options.submap_voxel) {
   find_registration_method(options.verification.coarse_method);
   find_registration_method(options.verification.fine_method);
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
@@ -175,7 +175,7 @@ bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pos
     odometry =
         keyframes_.empty() ? Pose::Identity() : keyframes_.back().odometry * frame_offset_.back();
   odometry = orthonormalized(odometry);
-  recent_.push_back({clean_points(points, options_.submap_voxel), odometry});
+  recent_.push_back({clean_points(points, frame_voxel_), odometry});
   while (recent_.size() > options_.submap_frames) recent_.pop_front();
 
   bool new_keyframe = keyframes_.empty();
@@ -215,17 +215,28 @@ bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pos
   return new_keyframe;
 }
 
-PointCloud LoopClosure3D::build_submap(const Pose& keyframe_odometry) const {
+PointCloud LoopClosure3D::build_submap(const Pose& keyframe_odometry) {
   const Pose keyframe_inverse = keyframe_odometry.inverse();
   PointCloud merged;
   for (const RecentFrame& f : recent_) {
     const Eigen::Isometry3f T = (keyframe_inverse * f.odometry).cast<float>();
     for (const Point& p : f.points.points) merged.points.push_back(T * p);
   }
-  PointCloud submap = clean_points(merged, options_.submap_voxel);
-  for (double voxel = 1.5 * options_.submap_voxel;
-       submap.size() > options_.max_submap_points && voxel < 100.0; voxel *= 1.5)
+  double voxel = frame_voxel_;
+  PointCloud submap = clean_points(merged, voxel);
+  while (submap.size() > options_.max_submap_points && voxel < 100.0) {
+    voxel *= 1.5;
     submap = clean_points(submap, voxel);
+  }
+  // The next frames are kept at the voxel this submap needed (a dense sensor's frames are then
+  // not kept at 0.25 m only to be merged and coarsened again: on urban-hdl64 that was most of the
+  // time loop closure took), and finer again once submaps fit easily.
+  if (voxel > frame_voxel_)
+    frame_voxel_ = voxel;
+  else if (frame_voxel_ > options_.submap_voxel &&
+           static_cast<double>(submap.size()) * 1.5 * 1.5 <
+               static_cast<double>(options_.max_submap_points))
+    frame_voxel_ = std::max(options_.submap_voxel, frame_voxel_ / 1.5);
   return submap;
 }
 

@@ -82,7 +82,8 @@ struct LoopClosure3DOptions {
   double keyframe_distance = 1.0;
   double keyframe_angle = 15.0 * M_PI / 180;
   /// The keyframe's submap: the last this many frames (the keyframe's own included), in its
-  /// frame, downsampled to `submap_voxel` m. Frames are kept downsampled to that voxel too.
+  /// frame, downsampled to `submap_voxel` m. Frames are kept downsampled to that voxel too, or to
+  /// the coarser one the last submap needed to fit `max_submap_points`.
   std::size_t submap_frames = 10;
   double submap_voxel = 0.25;
   /// A submap with more points is downsampled again with a voxel 1.5 times larger, until it
@@ -199,7 +200,9 @@ class LoopClosure3D {
     PointCloud points;  ///< downsampled to submap_voxel
     Pose odometry;
   };
-  PointCloud build_submap(const Pose& keyframe_odometry) const;
+  /// The recent frames in the keyframe's frame, downsampled to fit max_submap_points; adapts
+  /// frame_voxel_.
+  PointCloud build_submap(const Pose& keyframe_odometry);
   void close_loops(std::size_t keyframe);
   void optimize();
   PoseGraph3D::Information loop_information(const Matrix6d& hessian) const;
@@ -211,6 +214,7 @@ class LoopClosure3D {
   PlaceDatabase3D places_;
   std::vector<Keyframe> keyframes_;
   std::deque<RecentFrame> recent_;
+  double frame_voxel_ = 0.0;  ///< m, the voxel new frames are kept at (submap_voxel or coarser)
   std::vector<std::size_t> frame_keyframe_;  ///< per frame, its keyframe
   std::vector<Pose> frame_offset_;           ///< per frame, its pose in its keyframe's frame
   std::vector<std::size_t> loop_edges_;      ///< graph edge index of each loops_ entry
