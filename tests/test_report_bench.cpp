@@ -236,3 +236,22 @@ TEST(Report, LoopClosedRunsShowBothTrajectoriesAndTheirLoopEdges) {
   std::ofstream(run + "/loops.json") << R"({"from": 0})";
   EXPECT_THROW(read_run_folder(run), Error);
 }
+
+TEST(Report, Map2DRunsShowTheirLoopClosureAgainstTheReference) {
+  TempDir dir;
+  const std::string run = dir.file("room");
+  const auto r = run_cli("map2d sim:room-2d --scans 300 --no-motion-distortion --loop-closure "
+                         "--quiet --out " +
+                         run);
+  ASSERT_EQ(r.status, 0) << r.output;
+  // The reference is the log's (here the simulator's) poses; map2d's timing has no 3D stages.
+  const RunFolder folder = read_run_folder(run);
+  ASSERT_TRUE(folder.ground_truth.has_value());
+  EXPECT_EQ(folder.ground_truth->size(), folder.poses.size());
+  EXPECT_TRUE(folder.timing.empty());
+  EXPECT_GT(folder.frames_per_second, 0.0);
+  ASSERT_TRUE(folder.optimized.has_value());
+  const std::string html = render_report({folder}, std::nullopt);
+  EXPECT_NE(html.find("<td>room (loop-closed)</td>"), std::string::npos);
+  EXPECT_NE(html.find("ground truth"), std::string::npos);
+}

@@ -246,10 +246,12 @@ std::string render_report(const std::vector<RunFolder>& runs,
     };
     const std::string color = palette_color(i);
     html += fmt::format(
-        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.2f}</td>{}"
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{}</td>{}"
         "<td>{}</td></tr>\n",
         html_escape(run.label), html_escape(run.method), run.poses.size(), run.frames_per_second,
-        mean_ms, accuracy(run.poses, run.label, color), bridged);
+        run.timing.empty() ? std::string("-") : fmt::format("{:.2f}", mean_ms),
+        accuracy(run.poses, run.label, color),
+        run.timing.empty() ? std::string("-") : std::to_string(bridged));
     paths.push_back(make_series(run.label, color, top_view(run.poses.poses)));
     if (run.optimized) {
       // Loop closure: the odometry fades; the optimized poses and the loop edges between them

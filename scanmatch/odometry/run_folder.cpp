@@ -1,6 +1,7 @@
 #include "scanmatch/odometry/run_folder.hpp"
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "scanmatch/core/error.hpp"
@@ -26,12 +27,22 @@ RunFolder read_run_folder(const std::string& path) {
     run.ground_truth = read_trajectory(path + "/poses_gt_tum.txt");
   else if (fs::exists(path + "/poses_gt.txt"))
     run.ground_truth = read_trajectory(path + "/poses_gt.txt");
-  if (fs::exists(path + "/timing.csv")) run.timing = read_timing_csv(path + "/timing.csv");
+  else if (fs::exists(path + "/poses_reference_tum.txt"))  // map2d: the log's corrected poses
+    run.ground_truth = read_trajectory(path + "/poses_reference_tum.txt");
+  // map2d's timing.csv (one row per scan: scan,ms,...) has none of the 3D stages or health
+  // fields; its runs are shown without the per-frame plots.
+  const std::string timing = path + "/timing.csv";
+  if (fs::exists(timing)) {
+    std::ifstream in(timing);
+    std::string header;
+    std::getline(in, header);
+    if (header.rfind("scan,ms,", 0) != 0) run.timing = read_timing_csv(timing);
+  }
   if (fs::exists(path + "/summary.json")) {
     try {
       const auto j = nlohmann::json::parse(read_file_bytes(path + "/summary.json"));
       run.method = j.value("method", std::string("?"));
-      run.frames_per_second = j.value("frames_per_second", 0.0);
+      run.frames_per_second = j.value("frames_per_second", j.value("scans_per_second", 0.0));
       run.interrupted = j.value("interrupted", false);
     } catch (const nlohmann::json::exception& e) {
       fail(path + "/summary.json", std::string("malformed: ") + e.what());
