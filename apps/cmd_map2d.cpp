@@ -56,8 +56,8 @@ void add_map2d_command(CLI::App& app) {
   auto* cmd =
       app.add_subcommand("map2d", "2D laser scan-to-scan mapping: poses and an occupancy grid");
   cmd->add_option("SEQUENCE", c->sequence,
-                  "A CARMEN log (.log, .log.gz), a simulated 2D data set folder, sim:room-2d or a "
-                  "ROS bag (.bag, .db3, .mcap) with LaserScan messages")
+                  "A CARMEN log (.log, .log.gz), a simulated 2D data set folder, sim:room-2d, "
+                  "sim:corridor-2d or a ROS bag (.bag, .db3, .mcap) with LaserScan messages")
       ->required();
   cmd->add_option("--out", c->out, "Run folder (created)")->required();
   cmd->add_option("--topic", c->topic,

@@ -62,9 +62,9 @@ TEST(SimScene, RaycastMatchesAnalyticPlaneBoxAndCylinder) {
 }
 
 TEST(SimSensor, PatternsMatchTheSensorTable) {
-  const std::pair<const char*, std::size_t> expected[] = {{"mid360", 20000}, {"avia", 24000},
-                                                          {"vlp16", 28800},  {"hdl64", 120000},
-                                                          {"os1-64", 65536}, {"neato", 360}};
+  const std::pair<const char*, std::size_t> expected[] = {
+      {"mid360", 20000}, {"avia", 24000}, {"vlp16", 28800}, {"hdl64", 120000},
+      {"os1-64", 65536}, {"neato", 360},  {"sick-lms", 181}};
   for (const auto& [name, rays] : expected) {
     const SensorModel& s = sensor_model(name);
     RayPattern p;

@@ -221,7 +221,7 @@ motion prior (last_stats["bridged"]).)doc")
             return py::make_tuple(points, scan.circular);
           },
           py::arg("index"),
-          "Scan i of a 2D preset (room-2d): ((N, 2) x y in beam order, circular), as "
+          "Scan i of a 2D preset (room-2d, corridor-2d): ((N, 2) x y in beam order, circular), as "
           "register2d and Mapper2D take them");
 }
 

@@ -76,10 +76,10 @@ Scans2D load_scans_2d(const std::string& spec, const SequenceOptions& options,
     if (max_scans > 0) o.frames = max_scans;
     const sim::Simulator simulator(o);
     if (!simulator.sensor().is_2d())
-      throw Error(spec + ": not a 2D preset (the 2D preset is room-2d)");
+      throw Error(spec + ": not a 2D preset (the 2D presets are room-2d and corridor-2d)");
     for (std::size_t i = 0; i < simulator.size(); ++i) out.scans.push_back(simulator.scan_2d(i));
     out.has_reference = true;
-    if (o.motion_distortion) out.rotation_period = simulator.sensor().frame_period();
+    if (o.motion_distortion) out.rotation_period = simulator.sensor().rotation_period();
     out.description = fmt::format("{} (simulated, seed {})", spec, o.seed);
     return out;
   }

@@ -63,6 +63,21 @@ std::vector<SensorModel> make_models() {
   neato.range_noise_fraction = 0.01;
   neato.dropout = 0.01;
   m.push_back(neato);
+
+  // A SICK LMS as in the Radish 2D logs (ACES, Intel): 180 deg at 1 deg, logged about once a
+  // second, so consecutive scans are about a metre apart.
+  SensorModel sick;
+  sick.name = "sick-lms";
+  sick.pattern = ScanPattern::kPlanar;
+  sick.rate_hz = 1;
+  sick.mirror_period = 1.0 / 75.0;
+  sick.horizontal_fov_deg = 180;
+  sick.rays_per_frame = 181;
+  sick.min_range = 0.1;
+  sick.max_range = 50.0;
+  sick.range_noise = 0.015;
+  sick.dropout = 0.005;
+  m.push_back(sick);
   return m;
 }
 
@@ -82,6 +97,15 @@ Eigen::Vector3f direction(double azimuth, double elevation) {
                          static_cast<float>(std::sin(elevation)));
 }
 }  // namespace
+
+double SensorModel::planar_angle_min() const {
+  return is_full_turn() ? 0.0 : -0.5 * horizontal_fov_deg * kDeg;
+}
+
+double SensorModel::planar_angle_increment() const {
+  const double n = static_cast<double>(rays_per_frame);
+  return is_full_turn() ? 2 * M_PI / n : horizontal_fov_deg * kDeg / std::max(1.0, n - 1);
+}
 
 const SensorModel& sensor_model(const std::string& name) {
   for (const auto& m : models())
@@ -165,6 +189,17 @@ void generate_pattern(const SensorModel& s, std::uint64_t frame_index, RayPatter
       break;
     }
     case ScanPattern::kPlanar: {
+      if (!s.is_full_turn()) {
+        // The mirror sweeps the field of view in a fraction of its turn.
+        const double first = s.planar_angle_min(), step = s.planar_angle_increment();
+        for (std::size_t k = 0; k < n; ++k) {
+          const double offset = step * static_cast<double>(k);
+          p.directions[k] = direction(first + offset, 0.0);
+          p.times[k] = static_cast<float>(s.rotation_period() * offset / (2 * M_PI));
+          p.rings[k] = 0;
+        }
+        break;
+      }
       for (std::size_t k = 0; k < n; ++k) {
         const double angle = 2 * M_PI * static_cast<double>(k) / static_cast<double>(n);
         p.directions[k] = direction(angle, 0.0);

@@ -24,11 +24,21 @@ struct SensorModel {
   double range_noise = 0.02;                  ///< m, standard deviation
   double range_noise_fraction = 0.0;          ///< plus this fraction of the range (2D lasers)
   double dropout = 0.01;                      ///< probability a return is lost
+  /// s per turn of a planar laser's mirror (0: one turn per frame, as the Neato). A SICK LMS
+  /// turns at 75 Hz whatever rate its scans are logged at, so its scans hardly smear.
+  double mirror_period = 0.0;
   double frame_period() const { return 1.0 / rate_hz; }
+  double rotation_period() const { return mirror_period > 0.0 ? mirror_period : frame_period(); }
   bool is_2d() const { return pattern == ScanPattern::kPlanar; }
+  bool is_full_turn() const { return horizontal_fov_deg >= 360.0; }
+  /// Planar lasers: the first beam's angle and the angle between beams (rad, sensor frame). A
+  /// full turn starts at 0 (n beams around); a partial field of view is centred on x, its n beams
+  /// spanning it end to end (a SICK LMS: 181 beams from -90 to +90 deg).
+  double planar_angle_min() const;
+  double planar_angle_increment() const;
 };
 
-/// mid360, avia, vlp16, hdl64, os1-64, neato. Throws Error naming the valid ones.
+/// mid360, avia, vlp16, hdl64, os1-64, neato, sick-lms. Throws Error naming the valid ones.
 const SensorModel& sensor_model(const std::string& name);
 std::vector<std::string> sensor_names();
 

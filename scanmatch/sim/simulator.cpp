@@ -38,23 +38,32 @@ std::vector<PresetInfo> make_presets() {
        1200, 72.0},
       {"room-2d", "rooms-2d", "neato", "robot", "2D laser on a robot through a few rooms", 500,
        45.0},
+      {"corridor-2d", "corridors-2d", "sick-lms", "robot",
+       "180 deg SICK laser logged at 1 Hz around a ring of long office corridors (like Radish "
+       "ACES): scans about 0.9 m apart",
+       196, 175.0},
   };
 }
 
 World make_world(const std::string& scene, std::uint64_t seed) {
   if (scene == "office") return make_office(seed);
   if (scene == "campus") return make_campus(seed);
+  if (scene == "corridors-2d") return make_corridors_2d(seed);
   return make_rooms_2d(seed);
 }
 
 double sensor_height(const PresetInfo& p) {
   if (p.motion == "car") return 1.8;
   if (p.motion == "handheld" || p.motion == "walk") return 1.3;
-  if (p.scene == "rooms-2d") return 0.2;
+  if (is_2d_scene(p.scene)) return 0.2;
   return 0.5;
 }
 
 }  // namespace
+
+bool is_2d_scene(const std::string& scene) {
+  return scene == "rooms-2d" || scene == "corridors-2d";
+}
 
 const std::vector<PresetInfo>& presets() {
   static const std::vector<PresetInfo> kPresets = make_presets();
@@ -74,7 +83,7 @@ Simulator::Simulator(const SimOptions& options)
       preset_(&preset_info(options.preset)),
       sensor_(&sensor_model(options.sensor.empty() ? preset_->sensor : options.sensor)),
       world_(make_world(preset_->scene, options.seed)) {
-  if (sensor_->is_2d() != (preset_->scene == "rooms-2d"))
+  if (sensor_->is_2d() != is_2d_scene(preset_->scene))
     throw Error("sensor '" + sensor_->name + "' does not fit preset '" + preset_->name +
                 "' (2D sensors go with 2D presets)");
   frames_ = options.frames.value_or(preset_->frames);
@@ -193,15 +202,20 @@ LaserScan2D Simulator::scan_2d(std::size_t i) const {
   const PointCloud cloud = frame(i);
   LaserScan2D scan;
   const std::size_t n = sensor_->rays_per_frame;
+  const bool full_turn = sensor_->is_full_turn();
   scan.timestamp = frame_time(i);
-  scan.angle_min = 0.0;
-  scan.angle_increment = 2 * M_PI / static_cast<double>(n);
+  scan.angle_min = sensor_->planar_angle_min();
+  scan.angle_increment = sensor_->planar_angle_increment();
   scan.max_range = static_cast<float>(sensor_->max_range);
   scan.ranges.assign(n, scan.max_range);
   for (std::size_t k = 0; k < cloud.size(); ++k) {
     const double angle = std::atan2(cloud.points[k].y(), cloud.points[k].x());
-    const long beam = std::lround((angle < 0 ? angle + 2 * M_PI : angle) / scan.angle_increment) %
-                      static_cast<long>(n);
+    // A full turn wraps at 2 pi; a partial field of view (centred on x) never reaches it.
+    const long beam =
+        full_turn ? std::lround((angle < 0 ? angle + 2 * M_PI : angle) / scan.angle_increment) %
+                        static_cast<long>(n)
+                  : std::clamp(std::lround((angle - scan.angle_min) / scan.angle_increment), 0L,
+                               static_cast<long>(n) - 1);
     scan.ranges[static_cast<std::size_t>(beam)] = cloud.points[k].head<2>().norm();
   }
   const Pose gt = pose(i);

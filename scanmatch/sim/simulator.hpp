@@ -37,6 +37,8 @@ struct PresetInfo {
   double path_length = 0.0;  ///< m, 0 for still presets
 };
 const std::vector<PresetInfo>& presets();
+/// Scenes for planar lasers (rooms-2d, corridors-2d): they go with 2D sensors only.
+bool is_2d_scene(const std::string& scene);
 /// Throws Error naming the valid presets.
 const PresetInfo& preset_info(const std::string& name);
 

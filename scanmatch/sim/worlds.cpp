@@ -57,6 +57,41 @@ void furnish_hall(Scene& scene, Rng& rng, double x0, double x1, double y0, doubl
   for (double x = x0 + 3.0; x < x1 - 2.0; x += 4.0)
     for (double y : {y0 + 2.5, y1 - 2.5}) scene.add(Cylinder{{x, y}, 0.25, 0.0, height, 0.5f});
 }
+
+// One side wall of a corridor from a to b (`outward` points away from the corridor) with doors
+// at irregular spacing, each a shallow recess or the door of a small room behind the wall, and a
+// box against the wall between some of them.
+void corridor_wall(Scene& scene, Rng& rng, Eigen::Vector2d a, Eigen::Vector2d b,
+                   Eigen::Vector2d outward, double z0, double z1) {
+  const double length = (b - a).norm();
+  const Eigen::Vector2d u = (b - a) / length;
+  std::vector<std::pair<double, double>> doors;
+  double last_end = 0.0;
+  // Doors start 7 m from the ends so that the rooms of the two walls at a corner do not meet.
+  for (double t = rng.uniform(7, 11); t < length - 7; t += rng.uniform(3, 9)) {
+    const bool room = rng.uniform() < 0.35;
+    const double door = room ? 0.9 : 1.0;
+    const double half = room ? 0.5 * rng.uniform(3.0, 4.5) : 0.5 * door;
+    const double depth = room ? rng.uniform(3.0, 4.0) : 0.25;
+    const Eigen::Vector2d left = a + (t - half) * u, right = a + (t + half) * u;
+    wall(scene, left, left + depth * outward, z0, z1);
+    wall(scene, right, right + depth * outward, z0, z1);
+    wall(scene, left + depth * outward, right + depth * outward, z0, z1);
+    if (room) {
+      const Eigen::Vector2d c = a + (t + rng.uniform(-0.5, 0.5) * half) * u + 0.6 * depth * outward;
+      box_at(scene, c.x(), c.y(), z0, {1.2, 0.7, z1 - z0}, rng.uniform(0, 1.5), 0.5f);
+    }
+    const double start = t - half;
+    if (start - last_end > 3.0 && rng.uniform() < 0.4) {
+      const Eigen::Vector2d c = a + 0.5 * (last_end + start) * u - 0.3 * outward;
+      box_at(scene, c.x(), c.y(), z0, {0.8, 0.8, z1 - z0}, std::atan2(u.y(), u.x()), 0.7f);
+    }
+    doors.emplace_back(t, door);
+    last_end = t + half;
+    t += half;  // the next room starts past this one
+  }
+  wall_with_doors(scene, a, b, doors, z0, z1);
+}
 }  // namespace
 
 World make_office(std::uint64_t seed) {
@@ -221,6 +256,32 @@ World make_rooms_2d(std::uint64_t seed) {
   w.loop = {{1.5, 5.0}, {2.5, 2.5},  {2.5, 5.0},  {7.5, 5.0}, {7.5, 2.2},
             {7.5, 5.0}, {12.5, 5.0}, {12.5, 2.0}, {13.5, 5.2}};
   w.still_position = Eigen::Vector3d(2.5, 2.0, 0.0);
+  s.commit();
+  return w;
+}
+
+World make_corridors_2d(std::uint64_t seed) {
+  Rng rng(hash_combine(seed, 0xC022));
+  World w;
+  Scene& s = w.scene;
+  // Walls reach below the floor (there is none): a tilted scan plane must not pass under them.
+  const double z0 = -1.0, z1 = 2.0;
+  const double lx = 60, ly = 25, r = kCorridorHalfWidth;
+  // Outer walls, rooms outside the ring; inner walls, rooms inside the block the ring encloses.
+  corridor_wall(s, rng, {-r, -r}, {lx + r, -r}, {0, -1}, z0, z1);
+  corridor_wall(s, rng, {lx + r, -r}, {lx + r, ly + r}, {1, 0}, z0, z1);
+  corridor_wall(s, rng, {lx + r, ly + r}, {-r, ly + r}, {0, 1}, z0, z1);
+  corridor_wall(s, rng, {-r, ly + r}, {-r, -r}, {-1, 0}, z0, z1);
+  corridor_wall(s, rng, {r, r}, {lx - r, r}, {0, 1}, z0, z1);
+  corridor_wall(s, rng, {lx - r, r}, {lx - r, ly - r}, {-1, 0}, z0, z1);
+  corridor_wall(s, rng, {lx - r, ly - r}, {r, ly - r}, {0, -1}, z0, z1);
+  corridor_wall(s, rng, {r, ly - r}, {r, r}, {1, 0}, z0, z1);
+  // Along the centre lines; waypoints 1.5 m either side of each corner make square turns, and
+  // (1.5, 0), (6, 0), (12, 0), (24, 0) in a row make the start exactly straight along +x.
+  w.loop = {{12, 0},    {24, 0},    {36, 0},    {48, 0},  {58.5, 0}, {60, 1.5},
+            {60, 12.5}, {60, 23.5}, {58.5, 25}, {45, 25}, {30, 25},  {15, 25},
+            {1.5, 25},  {0, 23.5},  {0, 12.5},  {0, 1.5}, {1.5, 0},  {6, 0}};
+  w.still_position = Eigen::Vector3d(12, 0, 0.0);
   s.commit();
   return w;
 }

@@ -22,5 +22,11 @@ World make_office(std::uint64_t seed);
 World make_campus(std::uint64_t seed);
 /// A small flat of rooms for the 2D laser: walls 1 m high, doors, furniture.
 World make_rooms_2d(std::uint64_t seed);
+/// A ring of office corridors for a long-range 2D laser (like Radish ACES): centre lines on a
+/// 60 m x 25 m rectangle, 2.4 m wide (walls at +-kCorridorHalfWidth), plain walls broken only by
+/// door recesses and side rooms at irregular spacing and a few boxes against the walls. The
+/// loop goes once around, starting at (12, 0) heading +x along the bottom corridor.
+World make_corridors_2d(std::uint64_t seed);
+inline constexpr double kCorridorHalfWidth = 1.2;
 
 }  // namespace scanmatch::sim
