@@ -210,8 +210,9 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
   // A non-finite odometry pose would poison the graph: hold the last one instead.
   Pose2 odometry = odometry_pose;
   if (!odometry.matrix().allFinite())
-    odometry =
-        keyframes_.empty() ? Pose2::Identity() : keyframes_.back().odometry * scan_offset_.back();
+    odometry = keyframes_.empty()
+                   ? Pose2::Identity()
+                   : keyframes_.back().odometry * graph_.offset_in_keyframe(scans() - 1);
   bool new_keyframe = keyframes_.empty();
   if (!new_keyframe) {
     const Pose2 motion = keyframes_.back().odometry.inverse() * odometry;
@@ -220,19 +221,19 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
   }
   if (new_keyframe) {
     Keyframe k;
-    k.scan = scan_keyframe_.size();
+    k.scan = scans();
     k.points = scan;
     k.odometry = odometry;
     const std::size_t index = keyframes_.size();
     if (index == 0) {
-      graph_.add_node(odometry);
+      graph_.graph().add_node(odometry);
       keyframes_.push_back(std::move(k));
     } else {
       const Keyframe& previous = keyframes_.back();
       const Pose2 measurement = previous.odometry.inverse() * odometry;
       k.path = previous.path + measurement.translation().norm();
-      graph_.add_node(graph_.pose(index - 1) * measurement);
-      graph_.add_edge(
+      graph_.graph().add_node(graph().pose(index - 1) * measurement);
+      graph_.graph().add_edge(
           index - 1, index, measurement,
           diagonal_information(options_.odometry_sigma_xy, options_.odometry_sigma_theta),
           EdgeKind::kOdometry);
@@ -242,8 +243,7 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
     ++counts_.keyframes;
     if (index % options_.search_every == 0) close_loops(index);
   }
-  scan_keyframe_.push_back(keyframes_.size() - 1);
-  scan_offset_.push_back(keyframes_.back().odometry.inverse() * odometry);
+  graph_.add_frame(keyframes_.size() - 1, keyframes_.back().odometry.inverse() * odometry);
   counts_.total_ms += elapsed_ms(start);
   return new_keyframe;
 }
@@ -251,13 +251,13 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
 void LoopClosure2D::close_loops(std::size_t keyframe) {
   if (keyframe <= options_.skip_recent) return;
   const std::size_t last_candidate = keyframe - options_.skip_recent;  // exclusive
-  const Pose2& here = graph_.pose(keyframe);
+  const Pose2& here = graph().pose(keyframe);
   // Candidates with the relative pose each implies (current keyframe in the candidate's frame).
   std::vector<std::pair<std::size_t, Pose2>> candidates;
   if (options_.max_proximity_candidates > 0) {
     std::vector<std::pair<double, std::size_t>> near;
     for (std::size_t k = 0; k < last_candidate; ++k) {
-      const double d = (graph_.pose(k).translation() - here.translation()).norm();
+      const double d = (graph().pose(k).translation() - here.translation()).norm();
       if (d <= options_.proximity_radius) near.emplace_back(d, k);
     }
     std::sort(near.begin(), near.end());
@@ -270,7 +270,7 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
       });
       if (same_visit) continue;
       chosen.push_back(k);
-      candidates.emplace_back(k, graph_.pose(k).inverse() * here);
+      candidates.emplace_back(k, graph().pose(k).inverse() * here);
     }
   }
   if (options_.max_descriptor_candidates > 0) {
@@ -293,7 +293,7 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
       ++counts_.rejected_by_verification;
       continue;
     }
-    const Pose2 estimated = graph_.pose(k).inverse() * here;
+    const Pose2 estimated = graph().pose(k).inverse() * here;
     const double allowed =
         options_.max_correction +
         options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
@@ -310,39 +310,29 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
     loop.relative = v.transform;
     loop.paired_fraction = v.paired_fraction;
     loop.error = v.error;
-    loop_edges_.push_back(graph_.add_edge(
-        k, keyframe, v.transform,
-        diagonal_information(options_.loop_sigma_xy, options_.loop_sigma_theta), EdgeKind::kLoop));
-    loops_.push_back(loop);
+    graph_.add_loop(loop, diagonal_information(options_.loop_sigma_xy, options_.loop_sigma_theta));
     added = true;
   }
   if (added) optimize();
 }
 
 void LoopClosure2D::optimize() {
-  const PoseGraphSummary s = graph_.optimize();
+  counts_.outliers = graph_.optimize();
   ++counts_.optimizations;
-  for (std::size_t i = 0; i < loops_.size(); ++i)
-    loops_[i].outlier = std::find(s.outlier_edges.begin(), s.outlier_edges.end(), loop_edges_[i]) !=
-                        s.outlier_edges.end();
-  counts_.outliers = s.outlier_edges.size();
 }
 
 void LoopClosure2D::finish() {
   const auto start = std::chrono::steady_clock::now();
-  if (!loops_.empty()) optimize();
+  if (!loops().empty()) optimize();
   counts_.total_ms += elapsed_ms(start);
 }
 
 Pose2 LoopClosure2D::pose(std::size_t index) const {
-  return graph_.pose(scan_keyframe_.at(index)) * scan_offset_.at(index);
+  return graph_.pose(index);
 }
 
 std::vector<Pose2> LoopClosure2D::poses() const {
-  std::vector<Pose2> out;
-  out.reserve(scans());
-  for (std::size_t i = 0; i < scans(); ++i) out.push_back(pose(i));
-  return out;
+  return graph_.poses();
 }
 
 }  // namespace scanmatch

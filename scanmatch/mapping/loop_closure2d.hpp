@@ -19,6 +19,7 @@
 
 #include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/features/place_descriptor.hpp"
+#include "scanmatch/mapping/keyframe_graph.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
 
 namespace scanmatch {
@@ -136,15 +137,15 @@ class LoopClosure2D {
   /// Optimizes once more (so the outlier flags are current); call after the last scan.
   void finish();
 
-  std::size_t scans() const { return scan_keyframe_.size(); }
+  std::size_t scans() const { return graph_.frames(); }
   /// The optimized pose of scan `index`: its keyframe's optimized pose followed by the odometry
   /// motion from that keyframe.
   Pose2 pose(std::size_t index) const;
   std::vector<Pose2> poses() const;
   /// Every accepted loop edge, in order of addition.
-  const std::vector<Loop2D>& loops() const { return loops_; }
+  const std::vector<Loop2D>& loops() const { return graph_.loops(); }
   const LoopClosure2DCounts& counts() const { return counts_; }
-  const PoseGraph2D& graph() const { return graph_; }
+  const PoseGraph2D& graph() const { return graph_.graph(); }
 
  private:
   struct Keyframe {
@@ -157,13 +158,9 @@ class LoopClosure2D {
   void optimize();
 
   LoopClosure2DOptions options_;
-  PoseGraph2D graph_;
+  KeyframeGraph<2, Loop2D> graph_;
   PlaceDatabase2D places_;
   std::vector<Keyframe> keyframes_;
-  std::vector<std::size_t> scan_keyframe_;  ///< per scan, its keyframe
-  std::vector<Pose2> scan_offset_;          ///< per scan, its pose in its keyframe's frame
-  std::vector<std::size_t> loop_edges_;     ///< graph edge index of each loops_ entry
-  std::vector<Loop2D> loops_;
   LoopClosure2DCounts counts_;
 };
 

@@ -172,8 +172,8 @@ bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pos
   // A non-finite or non-rigid odometry pose would poison the graph: hold the last one instead.
   Pose odometry = odometry_pose;
   if (!is_valid_pose(odometry.matrix(), 1e-3))
-    odometry =
-        keyframes_.empty() ? Pose::Identity() : keyframes_.back().odometry * frame_offset_.back();
+    odometry = keyframes_.empty() ? Pose::Identity()
+                                  : keyframes_.back().odometry * offset_in_keyframe(frames() - 1);
   odometry = orthonormalized(odometry);
   recent_.push_back({clean_points(points, frame_voxel_), odometry});
   while (recent_.size() > options_.submap_frames) recent_.pop_front();
@@ -186,31 +186,30 @@ bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pos
   }
   if (new_keyframe) {
     Keyframe k;
-    k.frame = frame_keyframe_.size();
+    k.frame = frames();
     k.submap = build_submap(odometry);
     k.odometry = odometry;
     const std::size_t index = keyframes_.size();
     if (index == 0) {
-      graph_.add_node(odometry);
+      graph_.graph().add_node(odometry);
     } else {
       const Keyframe& previous = keyframes_.back();
       const Pose measurement = orthonormalized(previous.odometry.inverse() * odometry);
       k.path = previous.path + measurement.translation().norm();
-      graph_.add_node(orthonormalized(graph_.pose(index - 1) * measurement));
-      graph_.add_edge(index - 1, index, measurement,
-                      diagonal_information(options_.odometry_sigma_translation,
-                                           options_.odometry_sigma_rotation),
-                      EdgeKind::kOdometry);
+      graph_.graph().add_node(orthonormalized(graph().pose(index - 1) * measurement));
+      graph_.graph().add_edge(index - 1, index, measurement,
+                              diagonal_information(options_.odometry_sigma_translation,
+                                                   options_.odometry_sigma_rotation),
+                              EdgeKind::kOdometry);
     }
     places_.add(make_place_descriptor(k.submap, options_.descriptor));
     keyframes_.push_back(std::move(k));
     ++counts_.keyframes;
     const bool pausing =
-        !loops_.empty() && index <= last_loop_keyframe_ + options_.keyframes_between_loops;
+        !loops().empty() && index <= last_loop_keyframe_ + options_.keyframes_between_loops;
     if (index % options_.search_every == 0 && !pausing) close_loops(index);
   }
-  frame_keyframe_.push_back(keyframes_.size() - 1);
-  frame_offset_.push_back(keyframes_.back().odometry.inverse() * odometry);
+  graph_.add_frame(keyframes_.size() - 1, keyframes_.back().odometry.inverse() * odometry);
   counts_.total_ms += elapsed_ms(start);
   return new_keyframe;
 }
@@ -243,13 +242,13 @@ PointCloud LoopClosure3D::build_submap(const Pose& keyframe_odometry) {
 void LoopClosure3D::close_loops(std::size_t keyframe) {
   if (keyframe <= options_.skip_recent) return;
   const std::size_t last_candidate = keyframe - options_.skip_recent;  // exclusive
-  const Pose here = graph_.pose(keyframe);
+  const Pose here = graph().pose(keyframe);
   // Candidates with the relative pose each implies (current keyframe in the candidate's frame).
   std::vector<std::pair<std::size_t, Pose>> candidates;
   if (options_.max_proximity_candidates > 0) {
     std::vector<std::pair<double, std::size_t>> near;
     for (std::size_t k = 0; k < last_candidate; ++k) {
-      const double d = (graph_.pose(k).translation() - here.translation()).norm();
+      const double d = (graph().pose(k).translation() - here.translation()).norm();
       if (d <= options_.proximity_radius) near.emplace_back(d, k);
     }
     std::sort(near.begin(), near.end());
@@ -262,7 +261,7 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
       });
       if (same_visit) continue;
       chosen.push_back(k);
-      candidates.emplace_back(k, orthonormalized(graph_.pose(k).inverse() * here));
+      candidates.emplace_back(k, orthonormalized(graph().pose(k).inverse() * here));
     }
   }
   if (options_.max_descriptor_candidates > 0) {
@@ -281,7 +280,7 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
       // The descriptor knows the yaw only: the coarse registration finds the translation. A
       // registration moves its start by a few metres at most, so a start this far from the
       // estimate could not end within its gate (close_loops' check after verification).
-      const double distance = (graph_.pose(c.index).translation() - here.translation()).norm();
+      const double distance = (graph().pose(c.index).translation() - here.translation()).norm();
       if (distance > correction_allowed(keyframe, c.index) + options_.registration_reach) {
         ++counts_.ruled_out_by_estimate;
         continue;
@@ -293,7 +292,7 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
   bool added = false;
   for (const auto& [k, initial] : candidates) {
     ++counts_.candidates;
-    const Pose estimated = graph_.pose(k).inverse() * here;
+    const Pose estimated = graph().pose(k).inverse() * here;
     const double allowed = correction_allowed(keyframe, k);
     const LoopVerification3D v = verify_loop_3d(keyframes_[keyframe].submap, keyframes_[k].submap,
                                                 initial, options_.verification);
@@ -314,9 +313,7 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
     loop.relative = orthonormalized(v.transform);
     loop.overlap = v.overlap;
     loop.error = v.error;
-    loop_edges_.push_back(
-        graph_.add_edge(k, keyframe, loop.relative, loop_information(v.hessian), EdgeKind::kLoop));
-    loops_.push_back(loop);
+    graph_.add_loop(loop, loop_information(v.hessian));
     added = true;
   }
   if (added) {
@@ -364,29 +361,22 @@ PoseGraph3D::Information LoopClosure3D::loop_information(const Matrix6d& hessian
 }
 
 void LoopClosure3D::optimize() {
-  const PoseGraphSummary s = graph_.optimize();
+  counts_.outliers = graph_.optimize();
   ++counts_.optimizations;
-  for (std::size_t i = 0; i < loops_.size(); ++i)
-    loops_[i].outlier = std::find(s.outlier_edges.begin(), s.outlier_edges.end(), loop_edges_[i]) !=
-                        s.outlier_edges.end();
-  counts_.outliers = s.outlier_edges.size();
 }
 
 void LoopClosure3D::finish() {
   const auto start = std::chrono::steady_clock::now();
-  if (!loops_.empty()) optimize();
+  if (!loops().empty()) optimize();
   counts_.total_ms += elapsed_ms(start);
 }
 
 Pose LoopClosure3D::pose(std::size_t index) const {
-  return graph_.pose(frame_keyframe_.at(index)) * frame_offset_.at(index);
+  return graph_.pose(index);
 }
 
 std::vector<Pose> LoopClosure3D::poses() const {
-  std::vector<Pose> out;
-  out.reserve(frames());
-  for (std::size_t i = 0; i < frames(); ++i) out.push_back(pose(i));
-  return out;
+  return graph_.poses();
 }
 
 }  // namespace scanmatch

@@ -27,6 +27,7 @@
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/core/se3.hpp"
 #include "scanmatch/features/place_descriptor.hpp"
+#include "scanmatch/mapping/keyframe_graph.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
 
 namespace scanmatch {
@@ -172,22 +173,24 @@ class LoopClosure3D {
   /// Optimizes once more (so the outlier flags are current); call after the last frame.
   void finish();
 
-  std::size_t frames() const { return frame_keyframe_.size(); }
+  std::size_t frames() const { return graph_.frames(); }
   /// The optimized pose of frame `index`: its keyframe's optimized pose followed by the odometry
   /// motion from that keyframe.
   Pose pose(std::size_t index) const;
   std::vector<Pose> poses() const;
   /// Every accepted loop edge, in order of addition.
-  const std::vector<Loop3D>& loops() const { return loops_; }
+  const std::vector<Loop3D>& loops() const { return graph_.loops(); }
   const LoopClosure3DCounts& counts() const { return counts_; }
-  const PoseGraph3D& graph() const { return graph_; }
+  const PoseGraph3D& graph() const { return graph_.graph(); }
   /// Keyframe `k`'s submap (in its frame), as verification saw it.
   const PointCloud& submap(std::size_t keyframe) const { return keyframes_.at(keyframe).submap; }
   std::size_t keyframes() const { return keyframes_.size(); }
   /// The keyframe frame `index` belongs to (the last keyframe at or before it), and the frame's
   /// odometry pose in that keyframe's frame: pose(index) == graph().pose(keyframe) * offset.
-  std::size_t keyframe_of(std::size_t index) const { return frame_keyframe_.at(index); }
-  const Pose& offset_in_keyframe(std::size_t index) const { return frame_offset_.at(index); }
+  std::size_t keyframe_of(std::size_t index) const { return graph_.keyframe_of(index); }
+  const Pose& offset_in_keyframe(std::size_t index) const {
+    return graph_.offset_in_keyframe(index);
+  }
 
  private:
   struct Keyframe {
@@ -210,15 +213,11 @@ class LoopClosure3D {
   double correction_allowed(std::size_t keyframe, std::size_t candidate) const;
 
   LoopClosure3DOptions options_;
-  PoseGraph3D graph_;
+  KeyframeGraph<3, Loop3D> graph_;
   PlaceDatabase3D places_;
   std::vector<Keyframe> keyframes_;
   std::deque<RecentFrame> recent_;
   double frame_voxel_ = 0.0;  ///< m, the voxel new frames are kept at (submap_voxel or coarser)
-  std::vector<std::size_t> frame_keyframe_;  ///< per frame, its keyframe
-  std::vector<Pose> frame_offset_;           ///< per frame, its pose in its keyframe's frame
-  std::vector<std::size_t> loop_edges_;      ///< graph edge index of each loops_ entry
-  std::vector<Loop3D> loops_;
   std::size_t last_loop_keyframe_ = 0;  ///< the last keyframe that added a loop edge
   LoopClosure3DCounts counts_;
 };
