@@ -106,24 +106,23 @@ void add_map2d_command(CLI::App& app) {
               "{:.2f} deg, failures {:.1f} %\n",
               e->step, 1000 * e->mean_translation, e->mean_rotation * 180 / M_PI,
               1000 * e->median_translation, e->median_rotation * 180 / M_PI, 100 * e->failure_rate);
-      if (s.ate_odometry.poses > 0)
-        fmt::print(
-            "ATE (SE(2)-aligned) of the odometry: rmse {:.3f} m, max {:.3f} m; all pairs: "
-            "{:.3f} m, {:.2f} deg mean\n",
-            s.ate_odometry.rmse, s.ate_odometry.max, s.all_pairs_odometry.mean_translation,
-            s.all_pairs_odometry.mean_rotation * 180 / M_PI);
+      const auto print_ate = [](const char* what, const AbsoluteError2D& ate,
+                                const RelativeError2D& all_pairs) {
+        if (ate.poses > 0)
+          fmt::print(
+              "ATE (SE(2)-aligned) {}: rmse {:.3f} m, max {:.3f} m; all pairs: {:.3f} m, {:.2f} "
+              "deg mean\n",
+              what, ate.rmse, ate.max, all_pairs.mean_translation,
+              all_pairs.mean_rotation * 180 / M_PI);
+      };
+      print_ate("of the odometry", s.ate_odometry, s.all_pairs_odometry);
       if (s.loop_closure) {
         fmt::print(
             "loop closure: {} keyframes, {} candidates, {} verified, {} accepted ({} outliers), "
             "{:.2f} ms per scan\n",
             s.loops.keyframes, s.loops.candidates, s.loops.verified, s.accepted_loops,
             s.loops.outliers, s.loop_ms_per_scan);
-        if (s.ate_optimized.poses > 0)
-          fmt::print(
-              "ATE (SE(2)-aligned) loop-closed: rmse {:.3f} m, max {:.3f} m; all pairs: {:.3f} "
-              "m, {:.2f} deg mean\n",
-              s.ate_optimized.rmse, s.ate_optimized.max, s.all_pairs_optimized.mean_translation,
-              s.all_pairs_optimized.mean_rotation * 180 / M_PI);
+        print_ate("loop-closed", s.ate_optimized, s.all_pairs_optimized);
       }
       if (s.map_agreement >= 0)
         fmt::print("map agreement with map_reference (2 cells): {:.3f}{}\n", s.map_agreement,
