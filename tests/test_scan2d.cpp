@@ -303,6 +303,27 @@ TEST(Scan2D, CorrelativeSearchBridgesALargeStep) {
   EXPECT_LT((r.transform.translation() - truth.translation()).norm(), 0.01);
 }
 
+TEST(Scan2D, FilledSurfacesJoinAGrazingWallButNotADepthJump) {
+  // A wall along y = 1 seen at a grazing angle (samples 1 to 4 m apart), then a jump to a far
+  // wall along y = 6: the search's reference fills the first, never the gap between the two.
+  Scan2D scan;
+  for (double x : {10.0, 6.0, 3.0, 2.0}) scan.points.emplace_back(x, 1.0);
+  for (double x : {1.0, 0.0, -1.0}) scan.points.emplace_back(x, 6.0);
+  const std::vector<Vec2> filled = filled_surfaces(scan, 5.0, 0.1);
+  std::size_t on_near_wall = 0;
+  for (std::size_t i = scan.points.size(); i < filled.size(); ++i) {
+    const Vec2& p = filled[i];
+    const bool near_wall = std::abs(p.y() - 1.0) < 1e-9 && p.x() > 2.0 && p.x() < 10.0;
+    const bool far_wall = std::abs(p.y() - 6.0) < 1e-9 && p.x() > -1.0 && p.x() < 1.0;
+    EXPECT_TRUE(near_wall || far_wall) << p.transpose();
+    on_near_wall += near_wall;
+  }
+  EXPECT_GE(on_near_wall, 75u);  // 8 m of wall at 0.1 m steps
+  // Gaps above max_gap stay open; 0 turns filling off.
+  EXPECT_EQ(filled_surfaces(scan, 0.5, 0.1).size(), scan.points.size());
+  EXPECT_EQ(filled_surfaces(scan, 0.0, 0.1).size(), scan.points.size());
+}
+
 TEST(Scan2D, BadInputGivesClearErrors) {
   Scan2D tiny;
   tiny.points = {Vec2(1, 0), Vec2(0, 1)};

@@ -240,6 +240,8 @@ void describe(Registration2DOptions& r, Visitor& v) {
     "Correlative coarse search over +- this many m before matching (0: off)");
   v("search_angle", r.search_angle, nullptr, "correlative search, +- rad");
   v("search_resolution", r.search_resolution, nullptr, "correlative search grid, m");
+  v("search_fill_gap", r.search_fill_gap, "--search-fill-gap",
+    "Correlative search: fill straight surfaces between returns up to this many m apart (0: off)");
   v.nested("path_rules", r.path_rules);
 }
 

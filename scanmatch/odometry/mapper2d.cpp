@@ -11,6 +11,16 @@ Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
   check_registration_2d_method(config.registration.method);
 }
 
+bool Mapper2D::plausible_correction(const Pose2& correction) const {
+  // Never rejects what the correlative search was asked to look for.
+  const Registration2DOptions& r = config_.registration;
+  const bool search = r.search_window > 0.0;
+  return correction.translation().norm() <=
+             std::max(config_.max_correction, search ? r.search_window + 0.5 : 0.0) &&
+         std::abs(pose2_angle(correction)) <=
+             std::max(config_.max_correction_angle, search ? r.search_angle + 0.2 : 0.0);
+}
+
 namespace {
 
 /// Each point moved to where it would have been seen from the pose at the first beam, the sensor
@@ -59,9 +69,7 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   try {
     const Registration2DResult r = register_scans(current, reference, config_.registration, guess);
     const Pose2 correction = guess.inverse() * r.transform;
-    if (r.pairs >= 3 && r.transform.matrix().allFinite() &&
-        correction.translation().norm() <= config_.max_correction &&
-        std::abs(pose2_angle(correction)) <= config_.max_correction_angle) {
+    if (r.pairs >= 3 && r.transform.matrix().allFinite() && plausible_correction(correction)) {
       relative = r.transform;
       stats_.iterations = r.iterations;
       stats_.pairs = r.pairs;

@@ -19,7 +19,8 @@ struct Mapper2DConfig {
   double min_range = 0.05;  ///< m: nearer returns are dropped
   /// A result that moves farther than this from the initial guess is a failed match, not a
   /// motion: the scan is bridged by the guess, so that one failure does not become the next
-  /// scan's constant-velocity guess.
+  /// scan's constant-velocity guess. Widened to the correlative search's window (+0.5 m, +0.2
+  /// rad) where it runs: a turn the search was asked to find is not a failure.
   double max_correction = 2.0;                      ///< m
   double max_correction_angle = 60.0 * M_PI / 180;  ///< rad
   /// Scans are matched against the last keyframe, which is replaced once the sensor has moved
@@ -58,6 +59,8 @@ class Mapper2D {
   std::size_t scans() const { return scans_; }
 
  private:
+  bool plausible_correction(const Pose2& correction) const;
+
   Mapper2DConfig config_;
   Scan2D keyframe_, last_scan_;
   double last_timestamp_ = 0.0, motion_interval_ = 0.0;  ///< s; motion_ took motion_interval_

@@ -110,8 +110,38 @@ std::vector<Vec2> thinned(const std::vector<Vec2>& points, double cell) {
 
 }  // namespace
 
+std::vector<Vec2> filled_surfaces(const Scan2D& scan, double max_gap, double step) {
+  std::vector<Vec2> out = scan.points;
+  const long m = static_cast<long>(scan.points.size());
+  if (!(max_gap > 0.0) || !(step > 0.0) || m < 3) return out;
+  const auto point = [&](long k) -> const Vec2& {
+    return scan.points[static_cast<std::size_t>(k)];
+  };
+  // Whether `k` lies on the line through a and b (within 3 % of their distance, 5 cm at least).
+  const auto on_line = [&](long k, const Vec2& a, const Vec2& b) {
+    if (k < 0) return false;
+    const Vec2 d = b - a;
+    const double length = d.norm();
+    const double off = std::abs(d.x() * (point(k) - a).y() - d.y() * (point(k) - a).x()) / length;
+    return off <= std::max(0.05, 0.03 * length);
+  };
+  for (long i = 0; i < m; ++i) {
+    const long j = beam_neighbour(m, scan.circular, i, 1);
+    if (j < 0) continue;
+    const Vec2 &a = point(i), &b = point(j);
+    const double gap = (b - a).norm();
+    if (gap <= step || gap > max_gap) continue;
+    if (!on_line(beam_neighbour(m, scan.circular, i, -1), a, b) &&
+        !on_line(beam_neighbour(m, scan.circular, j, 1), a, b))
+      continue;
+    const int pieces = static_cast<int>(std::ceil(gap / step));
+    for (int k = 1; k < pieces; ++k) out.push_back(a + (b - a) * (static_cast<double>(k) / pieces));
+  }
+  return out;
+}
+
 Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
-                         double window, double angle_window, double resolution) {
+                         double window, double angle_window, double resolution, double fill_gap) {
   if (!(window > 0.0) || !(angle_window >= 0.0) || !(resolution > 0.0))
     throw Error("correlative search: window and resolution must be positive");
   if (current.points.empty() || reference.points.empty()) return initial;
@@ -142,7 +172,7 @@ Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const P
   low -= Vec2::Constant(margin);
   high += Vec2::Constant(margin);
   std::vector<Vec2> useful;
-  for (const Vec2& q : reference.points)
+  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
     if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
   if (useful.empty()) return initial;
   const LikelihoodGrid g = make_grid(useful, resolution);

@@ -36,6 +36,8 @@ void check_options(const Registration2DOptions& o) {
     throw Error("2D registration: a keep fraction must be in (0, 1]");
   if (!(o.sparse_min_pairs >= 0.0 && o.sparse_min_pairs < 1.0))
     throw Error("2D registration: sparse_min_pairs must be in [0, 1)");
+  if (!(o.search_fill_gap >= 0.0))
+    throw Error("2D registration: search_fill_gap must not be negative");
 }
 
 }  // namespace
@@ -87,10 +89,11 @@ Registration2DResult register_scans(const Scan2D& current, const Scan2D& referen
   check_options(o);
   check_scan(current, "current", method.min_points);
   check_scan(reference, "reference", method.min_points);
-  const Pose2 start = o.search_window > 0.0
-                          ? correlative_search(current, reference, initial, o.search_window,
-                                               o.search_angle, o.search_resolution)
-                          : initial;
+  const Pose2 start =
+      o.search_window > 0.0
+          ? correlative_search(current, reference, initial, o.search_window, o.search_angle,
+                               o.search_resolution, o.search_fill_gap)
+          : initial;
   return method.run(current, reference, o, start);
 }
 

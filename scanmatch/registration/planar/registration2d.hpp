@@ -89,6 +89,9 @@ struct Registration2DOptions {
   double search_window = 0.0;               ///< m, +- in x and y around the initial guess
   double search_angle = 45.0 * M_PI / 180;  ///< rad, +- around the initial guess
   double search_resolution = 0.05;          ///< m, cells of the search's likelihood grid
+  /// The search fills the reference's straight surfaces between beam neighbours up to this far
+  /// apart (filled_surfaces in correlative_search.hpp), m; 0: scores against the samples alone.
+  double search_fill_gap = 1.0;
 };
 
 struct Registration2DResult {
