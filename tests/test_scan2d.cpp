@@ -419,6 +419,29 @@ TEST(Metrics2D, AllPairsRelativeErrorOfAKnownDrift) {
   EXPECT_THROW(all_pairs_relative_error_2d(reference, {}), Error);
 }
 
+TEST(Map2D, WideSearchFindsATurnBeyondTheSearchAngle) {
+  // A 75-degree turn between two scans, as 1 Hz logs turn corners (ACES: up to 78), searched
+  // +-45 degrees from the identity: only the wide second search can find it.
+  const Pose2 start = pose2(2.0, 1.5, 0.0), turned = pose2(2.1, 1.6, 75 * M_PI / 180);
+  Mapper2DConfig config;
+  config.constant_velocity = false;
+  config.registration.search_window = 1.3;
+  config.registration.search_angle = 45 * M_PI / 180;
+  ASSERT_GE(config.wide_search_angle, 80 * M_PI / 180);  // on by default
+  const auto second_pose = [&](const Mapper2DConfig& c) {
+    Mapper2D mapper(c);
+    mapper.add_scan(room_scan(start));
+    return mapper.add_scan(room_scan(turned));
+  };
+  const Pose2 truth = start.inverse() * turned;
+  const Pose2 wide = second_pose(config);
+  EXPECT_LT((wide.translation() - truth.translation()).norm(), 0.05);
+  EXPECT_NEAR(degrees(pose2_angle(wide)), 75.0, 1.0);
+  config.wide_search_angle = 0.0;
+  const Pose2 narrow = second_pose(config);
+  EXPECT_GT(std::abs(degrees(pose2_angle(narrow)) - 75.0), 20.0);
+}
+
 TEST(Map2D, DeskewingStaysStableOnADistortedSequence) {
   // room-2d with motion distortion. Deskewing each scan by the step before it (the keyframe by an
   // older step) once made the poses oscillate and diverge (10 deg per step); both scans are now

@@ -256,6 +256,10 @@ void describe(Mapper2DConfig& c, Visitor& v) {
   v("keyframe_angle", c.keyframe_angle, nullptr, "rad: likewise for rotation");
   v("deskew", c.deskew, "--deskew",
     "Deskew scans by the last step's motion (experimental: see docs/planar.md)");
+  v("wide_search_angle", c.wide_search_angle, nullptr,
+    "rad: search again over +- this where few points fit (0: off)");
+  v("wide_search_below", c.wide_search_below, nullptr,
+    "share of points within 15 cm of the reference below which the wide search runs");
   v.nested("registration", c.registration);
 }
 

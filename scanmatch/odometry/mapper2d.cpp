@@ -4,6 +4,8 @@
 #include <chrono>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/kdtree.hpp"
+#include "scanmatch/registration/planar/correlative_search.hpp"
 
 namespace scanmatch {
 
@@ -18,10 +20,31 @@ bool Mapper2D::plausible_correction(const Pose2& correction) const {
   return correction.translation().norm() <=
              std::max(config_.max_correction, search ? r.search_window + 0.5 : 0.0) &&
          std::abs(pose2_angle(correction)) <=
-             std::max(config_.max_correction_angle, search ? r.search_angle + 0.2 : 0.0);
+             std::max(config_.max_correction_angle,
+                      search ? std::max(r.search_angle, config_.wide_search_angle) + 0.2 : 0.0);
 }
 
 namespace {
+
+/// The share of a scan's points within 15 cm of the reference's surfaces (filled between beams as
+/// the search fills them), at a pose in the reference's frame.
+class ScanFit {
+ public:
+  ScanFit(const Scan2D& reference, double fill_gap)
+      : surfaces_(filled_surfaces(reference, fill_gap, 0.05)), tree_(surfaces_) {}
+  double operator()(const Scan2D& scan, const Pose2& pose) const {
+    if (scan.points.empty()) return 0.0;
+    std::size_t near = 0, index = 0;
+    double squared = 0.0;
+    for (const Eigen::Vector2d& p : scan.points)
+      near += tree_.nearest(pose * p, 0.15 * 0.15, index, squared);
+    return static_cast<double>(near) / static_cast<double>(scan.points.size());
+  }
+
+ private:
+  std::vector<Eigen::Vector2d> surfaces_;
+  KdTree2 tree_;
+};
 
 /// Each point moved to where it would have been seen from the pose at the first beam, the sensor
 /// moving by `motion` every `interval` seconds. Misses carry no times and stay as measured.
@@ -67,7 +90,19 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   Pose2 relative = guess;
   const auto start = std::chrono::steady_clock::now();
   try {
-    const Registration2DResult r = register_scans(current, reference, config_.registration, guess);
+    Registration2DResult r = register_scans(current, reference, config_.registration, guess);
+    const Registration2DOptions& o = config_.registration;
+    if (o.search_window > 0.0 && config_.wide_search_angle > o.search_angle) {
+      // A turn beyond the search's angle window leaves most points off the reference.
+      const ScanFit fit(reference, o.search_fill_gap);
+      const double narrow = fit(current, r.transform);
+      if (narrow < config_.wide_search_below) {
+        Registration2DOptions wide = o;
+        wide.search_angle = config_.wide_search_angle;
+        const Registration2DResult w = register_scans(current, reference, wide, guess);
+        if (fit(current, w.transform) > narrow + 0.05) r = w;
+      }
+    }
     const Pose2 correction = guess.inverse() * r.transform;
     if (r.pairs >= 3 && r.transform.matrix().allFinite() && plausible_correction(correction)) {
       relative = r.transform;
