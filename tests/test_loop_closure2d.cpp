@@ -66,6 +66,34 @@ TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
   }
 }
 
+TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
+  // corridor-2d's 180-degree laser, 4 scans (~3.6 m) apart along a corridor: the older scan saw the
+  // stretch between them, which the newer one cannot, so scan against scan the share of points
+  // paired both ways stays low. Joined by its older neighbours (in its frame, by the true poses)
+  // the candidate becomes a submap onto which the newer scan pairs nearly everywhere.
+  const Scans2D input = load_scans_2d("sim:corridor-2d", {}, 40);
+  ASSERT_EQ(input.scans.size(), 40u);
+  const auto scan = [&](std::size_t i) { return scan_from_laser(input.scans[i], 0.05, 0.0, 0.0); };
+  const auto pose = [&](std::size_t i) { return pose2(input.scans[i].pose); };
+  const std::size_t current = 30, candidate = 26;
+  Scan2D submap = scan(candidate);
+  for (std::size_t j = candidate - 6; j < candidate; ++j)
+    for (const Eigen::Vector2d& p : scan(j).points)
+      submap.points.push_back(pose(candidate).inverse() * pose(j) * p);
+  const Pose2 truth = pose(candidate).inverse() * pose(current);
+  const Pose2 guess = truth * pose2(0.4, -0.3, 0.05);
+  const LoopVerification2DOptions options;
+  const LoopVerification2D alone = verify_loop_2d(scan(current), scan(candidate), guess, options);
+  const LoopVerification2D joined =
+      verify_loop_2d(scan(current), scan(candidate), guess, options, &submap);
+  EXPECT_FALSE(alone.accepted) << alone.paired_fraction;
+  EXPECT_LT(alone.paired_fraction, options.min_paired_fraction);
+  EXPECT_TRUE(joined.accepted) << joined.paired_fraction << " " << joined.error << " "
+                               << joined.free_violations << " " << joined.constraint;
+  EXPECT_LT((joined.transform.translation() - truth.translation()).norm(), 0.05);
+  EXPECT_NEAR(pose2_angle(joined.transform), pose2_angle(truth), 0.5 * M_PI / 180);
+}
+
 TEST(LoopClosure2D, VerificationRejectsTwoDifferentPlaces) {
   const Scans2D input = room_scans(400);
   const auto scan = [&](std::size_t i) { return scan_from_laser(input.scans[i], 0.05, 0.0, 0.0); };

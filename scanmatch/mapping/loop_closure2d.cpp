@@ -1,5 +1,7 @@
 #include "scanmatch/mapping/loop_closure2d.hpp"
 
+#include "scanmatch/registration/planar/correlative_search.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
@@ -110,8 +112,12 @@ Eigen::Vector2d beam_normal(const Scan2D& scan, std::size_t j) {
 
 // `from`'s points moved by `T` against `onto`'s points and free space.
 OverlapCheck check_overlap(const Scan2D& from, const Scan2D& onto, const Pose2& T,
-                           double pair_distance, double free_margin) {
-  const PointHash hash(onto.points, pair_distance);
+                           double pair_distance, double free_margin, double fill_gap) {
+  // Paired against `onto`'s surfaces filled between its samples, as the correlative search scores:
+  // two scans sample a far wall metres apart, and sample-to-sample pairs would miss true loops.
+  const std::vector<Eigen::Vector2d> surfaces =
+      filled_surfaces(onto, fill_gap, 0.5 * pair_distance);
+  const PointHash hash(surfaces, pair_distance);
   const RangeProfile profile(onto.points);
   std::size_t paired = 0, free = 0;
   double sum = 0.0;
@@ -155,7 +161,8 @@ double elapsed_ms(std::chrono::steady_clock::time_point since) {
 }  // namespace
 
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
-                                  const Pose2& initial, const LoopVerification2DOptions& options) {
+                                  const Pose2& initial, const LoopVerification2DOptions& options,
+                                  const Scan2D* candidate_submap) {
   LoopVerification2D out;
   out.transform = initial;
   const std::size_t min_points = std::max<std::size_t>(options.min_points, 3);
@@ -169,16 +176,22 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
   r.search_resolution = options.search_resolution;
   r.max_correspondence_distance = options.max_correspondence_distance;
   try {
-    out.transform = register_scans(current, candidate, r, initial).transform;
+    out.transform =
+        register_scans(current, candidate_submap ? *candidate_submap : candidate, r, initial)
+            .transform;
   } catch (const Error&) {
     return out;  // too few usable points for the method: not verifiable, so not a loop
   }
   if (!out.transform.matrix().allFinite()) return out;
   const OverlapCheck forward =
-      check_overlap(current, candidate, out.transform, options.pair_distance, options.free_margin);
-  const OverlapCheck backward = check_overlap(candidate, current, out.transform.inverse(),
-                                              options.pair_distance, options.free_margin);
-  out.paired_fraction = std::min(forward.paired_fraction, backward.paired_fraction);
+      check_overlap(current, candidate_submap ? *candidate_submap : candidate, out.transform,
+                    options.pair_distance, options.free_margin, r.search_fill_gap);
+  const OverlapCheck backward =
+      check_overlap(candidate, current, out.transform.inverse(), options.pair_distance,
+                    options.free_margin, r.search_fill_gap);
+  out.paired_fraction = candidate_submap
+                            ? forward.paired_fraction
+                            : std::min(forward.paired_fraction, backward.paired_fraction);
   out.error = std::max(forward.error, backward.error);
   out.free_violations = std::max(forward.free_violations, backward.free_violations);
   out.constraint = std::min(forward.constraint, backward.constraint);
@@ -287,8 +300,22 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
   bool added = false;
   for (const auto& [k, initial] : candidates) {
     ++counts_.candidates;
-    const LoopVerification2D v = verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points,
-                                                initial, options_.verification);
+    Scan2D submap;
+    if (options_.submap_keyframes > 0) {
+      submap = keyframes_[k].points;
+      const std::size_t first = k > options_.submap_keyframes ? k - options_.submap_keyframes : 0;
+      const std::size_t end = std::min(k + options_.submap_keyframes + 1, last_candidate);
+      for (std::size_t j = first; j < end; ++j) {
+        if (j == k) continue;
+        const Pose2 into_k = graph().pose(k).inverse() * graph().pose(j);
+        for (const Eigen::Vector2d& p : keyframes_[j].points.points)
+          submap.points.push_back(into_k * p);
+      }
+      submap.circular = false;
+    }
+    const LoopVerification2D v =
+        verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points, initial,
+                       options_.verification, options_.submap_keyframes > 0 ? &submap : nullptr);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;

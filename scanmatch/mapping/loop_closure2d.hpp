@@ -67,8 +67,13 @@ struct LoopVerification2D {
 
 /// Verifies that `current` and `candidate` show the same place, starting from `initial` (current
 /// in the candidate's frame). Never throws for bad scans (too few or non-finite points): rejects.
+/// With `candidate_submap` (the candidate's scan joined by its neighbours', in the candidate's
+/// frame) the current scan is registered onto and paired against the submap, whose wider view a
+/// 180-degree scan revisiting a place from elsewhere overlaps; the way back (candidate onto
+/// current) then checks only the error and the free space, not the paired share.
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
-                                  const Pose2& initial, const LoopVerification2DOptions& options);
+                                  const Pose2& initial, const LoopVerification2DOptions& options,
+                                  const Scan2D* candidate_submap = nullptr);
 
 struct LoopClosure2DOptions {
   /// A new keyframe once the odometry has moved this far from the last one (m or rad).
@@ -84,6 +89,10 @@ struct LoopClosure2DOptions {
   double loop_sigma_theta = 0.5 * M_PI / 180;
   /// The newest keyframes are never candidates (they are trivially the same place).
   std::size_t skip_recent = 30;
+  /// The candidate keyframe's neighbours within this many keyframes either side (older than the
+  /// skipped recent ones) join its scan as the verification's reference (verify_loop_2d's
+  /// candidate_submap). 0: scan against scan.
+  std::size_t submap_keyframes = 6;
   /// Pose-proximity candidates: earlier keyframes within this distance (m) of the new one in the
   /// current estimate, nearest first, at most `max_proximity_candidates` (0: none).
   double proximity_radius = 4.0;

@@ -395,6 +395,8 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
   v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
+  v("submap_keyframes", o.submap_keyframes, nullptr,
+    "the candidate's neighbours within this many keyframes join it for verification");
   v("proximity_radius", o.proximity_radius, nullptr,
     "Candidates within this distance in the current estimate, m");
   v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
