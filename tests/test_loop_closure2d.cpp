@@ -94,6 +94,25 @@ TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
   EXPECT_NEAR(pose2_angle(joined.transform), pose2_angle(truth), 0.5 * M_PI / 180);
 }
 
+TEST(LoopClosure2D, AMatchAlongAPlainCorridorHoldsNothingAlongIt) {
+  // A 180-degree scan down a corridor of plain walls (y = +-1.2 m): the match determines the
+  // across direction and the heading, nothing along x. The loop edge's information (the
+  // verification's Hessian) must say so, and the verification must not accept it as a loop.
+  Scan2D scan;
+  for (int beam = 0; beam <= 180; ++beam) {
+    const double a = (beam - 90) * M_PI / 180;
+    if (std::abs(std::sin(a)) < 0.05) continue;  // beyond 24 m: no return
+    const double r = 1.2 / std::abs(std::sin(a));
+    scan.points.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  const LoopVerification2D v =
+      verify_loop_2d(scan, scan, pose2(0.3, 0.1, 0.02), LoopVerification2DOptions{});
+  EXPECT_FALSE(v.accepted);
+  ASSERT_GT(v.hessian(1, 1), 0.0);
+  EXPECT_LT(v.hessian(0, 0), 1e-3 * v.hessian(1, 1));
+  EXPECT_GT(v.hessian(2, 2), 0.0);
+}
+
 TEST(LoopClosure2D, VerificationRejectsTwoDifferentPlaces) {
   const Scans2D input = room_scans(400);
   const auto scan = [&](std::size_t i) { return scan_from_laser(input.scans[i], 0.05, 0.0, 0.0); };

@@ -90,6 +90,9 @@ class RangeProfile {
 
 struct OverlapCheck {
   double paired_fraction = 0.0, error = 0.0, free_violations = 0.0, constraint = 0.0;
+  /// Gauss-Newton Hessian of the paired points' point-to-line distances, for a motion of `from`
+  /// in its own frame (x, y, theta): the pose graph's order and frame for an edge to `from`.
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
 };
 
 // Unit normal of point j from its beam neighbours (zero where they are missing or far).
@@ -119,6 +122,7 @@ OverlapCheck check_overlap(const Scan2D& from, const Scan2D& onto, const Pose2& 
       filled_surfaces(onto, fill_gap, 0.5 * pair_distance);
   const PointHash hash(surfaces, pair_distance);
   const RangeProfile profile(onto.points);
+  OverlapCheck c;
   std::size_t paired = 0, free = 0;
   double sum = 0.0;
   Eigen::Matrix2d normals = Eigen::Matrix2d::Zero();
@@ -130,11 +134,13 @@ OverlapCheck check_overlap(const Scan2D& from, const Scan2D& onto, const Pose2& 
       sum += d;
       const Eigen::Vector2d n = beam_normal(from, j);
       normals += n * n.transpose();
+      const Eigen::Vector2d& p = from.points[j];
+      const Eigen::Vector3d J(n.x(), n.y(), n.x() * -p.y() + n.y() * p.x());
+      c.hessian += J * J.transpose();
     } else if (profile.in_free_space(q, free_margin)) {
       ++free;
     }
   }
-  OverlapCheck c;
   const double n = static_cast<double>(std::max<std::size_t>(from.points.size(), 1));
   c.paired_fraction = static_cast<double>(paired) / n;
   c.free_violations = static_cast<double>(free) / n;
@@ -195,6 +201,7 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
   out.error = std::max(forward.error, backward.error);
   out.free_violations = std::max(forward.free_violations, backward.free_violations);
   out.constraint = std::min(forward.constraint, backward.constraint);
+  out.hessian = forward.hessian;
   out.accepted = out.paired_fraction >= options.min_paired_fraction &&
                  out.error <= options.max_error &&
                  out.free_violations <= options.max_free_violations &&
@@ -337,10 +344,39 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
     loop.relative = v.transform;
     loop.paired_fraction = v.paired_fraction;
     loop.error = v.error;
-    graph_.add_loop(loop, diagonal_information(options_.loop_sigma_xy, options_.loop_sigma_theta));
+    graph_.add_loop(loop, loop_information(v.hessian));
     added = true;
   }
   if (added) optimize();
+}
+
+Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) const {
+  const Eigen::Matrix3d fallback =
+      diagonal_information(options_.loop_sigma_xy, options_.loop_sigma_theta);
+  if (!options_.hessian_loop_information || !hessian.allFinite()) return fallback;
+  const Eigen::Matrix3d H = 0.5 * (hessian + hessian.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> translation(H.topLeftCorner<2, 2>());
+  const double strongest = translation.eigenvalues()(1);
+  if (!(strongest > 0.0)) return fallback;
+  // The shape of the match's certainty at the scale of loop_sigma_xy in its best direction: along
+  // a corridor a loop then holds nothing, so one that slid cannot pull the map along it.
+  Eigen::Matrix3d scaled = H / (strongest * options_.loop_sigma_xy * options_.loop_sigma_xy);
+  // The rotation's certainty at that scale claims the lever arm of the farthest points; capped
+  // at loop_sigma_theta (row and column scaled alike, so it stays positive semi-definite).
+  const double rotation_cap = 1.0 / (options_.loop_sigma_theta * options_.loop_sigma_theta);
+  if (scaled(2, 2) > rotation_cap) {
+    const double d = std::sqrt(rotation_cap / scaled(2, 2));
+    scaled.row(2) *= d;
+    scaled.col(2) *= d;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scaled);
+  if (eigen.info() != Eigen::Success) return fallback;
+  const double floor = 1e-6 * eigen.eigenvalues().maxCoeff();
+  const Eigen::Vector3d values = eigen.eigenvalues().cwiseMax(floor);
+  if (!(floor > 0.0) || !values.allFinite()) return fallback;
+  const Eigen::Matrix3d information =
+      eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
+  return 0.5 * (information + information.transpose());
 }
 
 void LoopClosure2D::optimize() {

@@ -63,6 +63,9 @@ struct LoopVerification2D {
   double error = 0.0;            ///< m, mean distance of the paired points
   double free_violations = 0.0;  ///< share of points in the other scan's free space (worst way)
   double constraint = 0.0;       ///< the weaker direction's share of the normals (worst way)
+  /// Gauss-Newton Hessian of the current scan's paired point-to-line distances at `transform`, in
+  /// (x, y, theta) of the current scan's frame (unscaled: the information's shape).
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
 };
 
 /// Verifies that `current` and `candidate` show the same place, starting from `initial` (current
@@ -93,6 +96,9 @@ struct LoopClosure2DOptions {
   /// skipped recent ones) join its scan as the verification's reference (verify_loop_2d's
   /// candidate_submap). 0: scan against scan.
   std::size_t submap_keyframes = 6;
+  /// Loop edges hold what the match determines (its Hessian's shape at loop_sigma_xy), not the
+  /// same certainty in every direction: a loop along a plain corridor holds nothing along it.
+  bool hessian_loop_information = true;
   /// Pose-proximity candidates: earlier keyframes within this distance (m) of the new one in the
   /// current estimate, nearest first, at most `max_proximity_candidates` (0: none).
   double proximity_radius = 4.0;
@@ -164,6 +170,9 @@ class LoopClosure2D {
     double path = 0.0;  ///< m of odometry travel since the first keyframe
   };
   void close_loops(std::size_t keyframe);
+  /// A loop edge's information: the verification's Hessian scaled to loop_sigma_xy in its best
+  /// direction, the rotation capped at loop_sigma_theta (or the diagonal of both sigmas).
+  Eigen::Matrix3d loop_information(const Eigen::Matrix3d& hessian) const;
   void optimize();
 
   LoopClosure2DOptions options_;

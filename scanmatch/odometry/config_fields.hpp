@@ -397,6 +397,8 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
   v("submap_keyframes", o.submap_keyframes, nullptr,
     "the candidate's neighbours within this many keyframes join it for verification");
+  v("hessian_loop_information", o.hessian_loop_information, nullptr,
+    "loop edges' information shaped by the match's Hessian (false: diagonal sigmas)");
   v("proximity_radius", o.proximity_radius, nullptr,
     "Candidates within this distance in the current estimate, m");
   v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
