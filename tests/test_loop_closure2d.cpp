@@ -71,11 +71,11 @@ TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
   // stretch between them, which the newer one cannot, so scan against scan the share of points
   // paired both ways stays low. Joined by its older neighbours (in its frame, by the true poses)
   // the candidate becomes a submap onto which the newer scan pairs nearly everywhere.
-  const Scans2D input = load_scans_2d("sim:corridor-2d", {}, 40);
-  ASSERT_EQ(input.scans.size(), 40u);
+  const Scans2D input = load_scans_2d("sim:corridor-2d", {}, 44);
+  ASSERT_EQ(input.scans.size(), 44u);
   const auto scan = [&](std::size_t i) { return scan_from_laser(input.scans[i], 0.05, 0.0, 0.0); };
   const auto pose = [&](std::size_t i) { return pose2(input.scans[i].pose); };
-  const std::size_t current = 30, candidate = 26;
+  const std::size_t current = 42, candidate = 38;  // past door recesses: not ambiguous
   Scan2D submap = scan(candidate);
   for (std::size_t j = candidate - 6; j < candidate; ++j)
     for (const Eigen::Vector2d& p : scan(j).points)
@@ -111,6 +111,49 @@ TEST(LoopClosure2D, AMatchAlongAPlainCorridorHoldsNothingAlongIt) {
   ASSERT_GT(v.hessian(1, 1), 0.0);
   EXPECT_LT(v.hessian(0, 0), 1e-3 * v.hessian(1, 1));
   EXPECT_GT(v.hessian(2, 2), 0.0);
+}
+
+TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
+  // Walls at y = +-1.2 m with a 0.6 m wide, 0.3 m deep door recess every 2 m on both sides, seen
+  // by a 180-degree laser (1 deg beams, 30 m). A scan matched 2 m along (one door further) fits as
+  // well as in place: without the shift test it would be accepted; with it, rejected.
+  struct Segment {
+    Eigen::Vector2d a, b;
+  };
+  std::vector<Segment> walls;
+  for (double x = -10.0; x < 40.0; x += 2.0)
+    for (double side : {-1.0, 1.0}) {
+      const double y = 1.2 * side, deep = 1.5 * side;
+      walls.push_back({{x, y}, {x + 1.4, y}});
+      walls.push_back({{x + 1.4, y}, {x + 1.4, deep}});
+      walls.push_back({{x + 1.4, deep}, {x + 2.0, deep}});
+      walls.push_back({{x + 2.0, deep}, {x + 2.0, y}});
+    }
+  const auto scan_at = [&](double x0) {
+    Scan2D scan;
+    for (int beam = 0; beam <= 180; ++beam) {
+      const double a = (beam - 90) * M_PI / 180;
+      const Eigen::Vector2d d(std::cos(a), std::sin(a)), o(x0, 0.0);
+      double best = 30.0;
+      for (const Segment& w : walls) {
+        Eigen::Matrix2d A;
+        A << d, w.a - w.b;
+        if (std::abs(A.determinant()) < 1e-12) continue;
+        const Eigen::Vector2d ts = A.inverse() * (w.a - o);
+        if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) best = std::min(best, ts.x());
+      }
+      if (best < 30.0) scan.points.push_back(best * d);
+    }
+    return scan;
+  };
+  const Scan2D here = scan_at(0.3), later = scan_at(2.3);  // one door further along
+  LoopVerification2DOptions options;
+  const LoopVerification2D checked = verify_loop_2d(later, here, pose2(0.1, 0.0, 0.0), options);
+  options.max_shifted_fraction = 0.0;
+  const LoopVerification2D unchecked = verify_loop_2d(later, here, pose2(0.1, 0.0, 0.0), options);
+  EXPECT_TRUE(unchecked.accepted) << unchecked.paired_fraction << " " << unchecked.constraint;
+  EXPECT_FALSE(checked.accepted);
+  EXPECT_GT(checked.shifted_fraction, 0.8);
 }
 
 TEST(LoopClosure2D, VerificationRejectsTwoDifferentPlaces) {

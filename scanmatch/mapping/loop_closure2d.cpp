@@ -206,6 +206,21 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
                  out.error <= options.max_error &&
                  out.free_violations <= options.max_free_violations &&
                  out.constraint >= options.min_constraint;
+  if (out.accepted && options.max_shifted_fraction > 0.0) {
+    // Slid along the direction the match determines least, does the scan fit nearly as well?
+    // Then the place is ambiguous there (a corridor, doors at even spacing): not a loop.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(out.hessian.topLeftCorner<2, 2>());
+    const Eigen::Vector2d weak = eigen.eigenvectors().col(0);
+    const Scan2D& onto = candidate_submap ? *candidate_submap : candidate;
+    for (double shift : {-3.0, -2.0, -1.0, 1.0, 2.0, 3.0}) {
+      const Pose2 shifted = out.transform * pose2(shift * weak.x(), shift * weak.y(), 0.0);
+      const OverlapCheck c = check_overlap(current, onto, shifted, options.pair_distance,
+                                           options.free_margin, r.search_fill_gap);
+      out.shifted_fraction = std::max(out.shifted_fraction,
+                                      c.paired_fraction / std::max(forward.paired_fraction, 1e-9));
+    }
+    out.accepted = out.shifted_fraction <= options.max_shifted_fraction;
+  }
   return out;
 }
 

@@ -52,6 +52,10 @@ struct LoopVerification2DOptions {
   /// a corridor's two walls give ~0 and slide along it to wherever the search window allows.
   double min_constraint = 0.1;
   std::size_t min_points = 40;  ///< each scan needs this many points to be verified at all
+  /// Rejected when the current scan, slid 1 to 3 m along the match's least determined direction,
+  /// keeps more than this share of its paired points (an ambiguous place: a corridor with doors at
+  /// even spacing). 0: not checked.
+  double max_shifted_fraction = 0.8;
 };
 
 /// The result of verifying one candidate: `transform` maps current points into the candidate's
@@ -66,6 +70,8 @@ struct LoopVerification2D {
   /// Gauss-Newton Hessian of the current scan's paired point-to-line distances at `transform`, in
   /// (x, y, theta) of the current scan's frame (unscaled: the information's shape).
   Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
+  /// The largest share of the paired points kept when slid along the weak direction (when checked).
+  double shifted_fraction = 0.0;
 };
 
 /// Verifies that `current` and `candidate` show the same place, starting from `initial` (current

@@ -310,6 +310,8 @@ void describe(LoopVerification2DOptions& o, Visitor& v) {
   v("min_constraint", o.min_constraint, nullptr,
     "The weaker direction's share of the paired normals, at least (corridors fail)");
   v("min_points", o.min_points, nullptr, "Points each scan needs to be verified");
+  v("max_shifted_fraction", o.max_shifted_fraction, nullptr,
+    "reject when slid 1-3 m along the weak direction keeps more of the pairs (0: off)");
 }
 
 template <typename Visitor>
