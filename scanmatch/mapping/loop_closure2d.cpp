@@ -113,15 +113,28 @@ Eigen::Vector2d beam_normal(const Scan2D& scan, std::size_t j) {
   return Eigen::Vector2d(-t.y(), t.x()).normalized();
 }
 
-// `from`'s points moved by `T` against `onto`'s points and free space.
-OverlapCheck check_overlap(const Scan2D& from, const Scan2D& onto, const Pose2& T,
-                           double pair_distance, double free_margin, double fill_gap) {
-  // Paired against `onto`'s surfaces filled between its samples, as the correlative search scores:
-  // two scans sample a far wall metres apart, and sample-to-sample pairs would miss true loops.
-  const std::vector<Eigen::Vector2d> surfaces =
-      filled_surfaces(onto, fill_gap, 0.5 * pair_distance);
-  const PointHash hash(surfaces, pair_distance);
-  const RangeProfile profile(onto.points);
+// What a scan is checked against: its surfaces filled between samples (as the correlative search
+// scores them: two scans sample a far wall metres apart, and sample-to-sample pairs would miss
+// true loops), hashed for the nearest pair, and the free space it saw. Built once per scan and
+// reused for every pose it is checked at.
+struct OverlapTarget {
+  OverlapTarget(const Scan2D& onto, double pair_distance, double fill_gap)
+      : surfaces(filled_surfaces(onto, fill_gap, 0.5 * pair_distance)),
+        hash(surfaces, pair_distance),
+        profile(onto.points) {}
+  OverlapTarget(const OverlapTarget&) = delete;  // `hash` refers to `surfaces`
+  OverlapTarget& operator=(const OverlapTarget&) = delete;
+
+  std::vector<Eigen::Vector2d> surfaces;
+  PointHash hash;
+  RangeProfile profile;
+};
+
+// `from`'s points moved by `T` against `onto`'s surfaces and free space.
+OverlapCheck check_overlap(const Scan2D& from, const OverlapTarget& onto, const Pose2& T,
+                           double free_margin) {
+  const PointHash& hash = onto.hash;
+  const RangeProfile& profile = onto.profile;
   OverlapCheck c;
   std::size_t paired = 0, free = 0;
   double sum = 0.0;
@@ -189,12 +202,13 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
     return out;  // too few usable points for the method: not verifiable, so not a loop
   }
   if (!out.transform.matrix().allFinite()) return out;
+  const OverlapTarget reference(candidate_submap ? *candidate_submap : candidate,
+                                options.pair_distance, r.search_fill_gap);
   const OverlapCheck forward =
-      check_overlap(current, candidate_submap ? *candidate_submap : candidate, out.transform,
-                    options.pair_distance, options.free_margin, r.search_fill_gap);
+      check_overlap(current, reference, out.transform, options.free_margin);
   const OverlapCheck backward =
-      check_overlap(candidate, current, out.transform.inverse(), options.pair_distance,
-                    options.free_margin, r.search_fill_gap);
+      check_overlap(candidate, OverlapTarget(current, options.pair_distance, r.search_fill_gap),
+                    out.transform.inverse(), options.free_margin);
   out.paired_fraction = candidate_submap
                             ? forward.paired_fraction
                             : std::min(forward.paired_fraction, backward.paired_fraction);
@@ -211,11 +225,9 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
     // Then the place is ambiguous there (a corridor, doors at even spacing): not a loop.
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(out.hessian.topLeftCorner<2, 2>());
     const Eigen::Vector2d weak = eigen.eigenvectors().col(0);
-    const Scan2D& onto = candidate_submap ? *candidate_submap : candidate;
     for (double shift : {-3.0, -2.0, -1.0, 1.0, 2.0, 3.0}) {
       const Pose2 shifted = out.transform * pose2(shift * weak.x(), shift * weak.y(), 0.0);
-      const OverlapCheck c = check_overlap(current, onto, shifted, options.pair_distance,
-                                           options.free_margin, r.search_fill_gap);
+      const OverlapCheck c = check_overlap(current, reference, shifted, options.free_margin);
       out.shifted_fraction = std::max(out.shifted_fraction,
                                       c.paired_fraction / std::max(forward.paired_fraction, 1e-9));
     }
@@ -368,30 +380,10 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
 Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) const {
   const Eigen::Matrix3d fallback =
       diagonal_information(options_.loop_sigma_xy, options_.loop_sigma_theta);
-  if (!options_.hessian_loop_information || !hessian.allFinite()) return fallback;
-  const Eigen::Matrix3d H = 0.5 * (hessian + hessian.transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> translation(H.topLeftCorner<2, 2>());
-  const double strongest = translation.eigenvalues()(1);
-  if (!(strongest > 0.0)) return fallback;
-  // The shape of the match's certainty at the scale of loop_sigma_xy in its best direction: along
-  // a corridor a loop then holds nothing, so one that slid cannot pull the map along it.
-  Eigen::Matrix3d scaled = H / (strongest * options_.loop_sigma_xy * options_.loop_sigma_xy);
-  // The rotation's certainty at that scale claims the lever arm of the farthest points; capped
-  // at loop_sigma_theta (row and column scaled alike, so it stays positive semi-definite).
-  const double rotation_cap = 1.0 / (options_.loop_sigma_theta * options_.loop_sigma_theta);
-  if (scaled(2, 2) > rotation_cap) {
-    const double d = std::sqrt(rotation_cap / scaled(2, 2));
-    scaled.row(2) *= d;
-    scaled.col(2) *= d;
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scaled);
-  if (eigen.info() != Eigen::Success) return fallback;
-  const double floor = 1e-6 * eigen.eigenvalues().maxCoeff();
-  const Eigen::Vector3d values = eigen.eigenvalues().cwiseMax(floor);
-  if (!(floor > 0.0) || !values.allFinite()) return fallback;
-  const Eigen::Matrix3d information =
-      eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
-  return 0.5 * (information + information.transpose());
+  // Along a corridor a loop then holds nothing, so one that slid cannot pull the map along it.
+  if (!options_.hessian_loop_information) return fallback;
+  return shaped_loop_information<2>(hessian, options_.loop_sigma_xy, options_.loop_sigma_theta,
+                                    fallback);
 }
 
 void LoopClosure2D::optimize() {

@@ -328,36 +328,11 @@ double LoopClosure3D::correction_allowed(std::size_t keyframe, std::size_t candi
 }
 
 PoseGraph3D::Information LoopClosure3D::loop_information(const Matrix6d& hessian) const {
-  const PoseGraph3D::Information fallback =
-      diagonal_information(options_.loop_sigma_translation, options_.loop_sigma_rotation);
-  if (!hessian.allFinite()) return fallback;
-  const Matrix6d H = 0.5 * (hessian + hessian.transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> translation(H.topLeftCorner<3, 3>());
-  const double strongest = translation.eigenvalues()(2);
-  if (!(strongest > 0.0)) return fallback;
-  // Keep the shape, set the scale; floor the eigenvalues so that the graph gets a positive
-  // definite matrix even for a direction the geometry leaves free.
-  Matrix6d scaled =
-      H / (strongest * options_.loop_sigma_translation * options_.loop_sigma_translation);
-  // The rotation block at that scale claims the points' lever arm (tens of metres) worth of
-  // certainty, a small fraction of a degree; submaps built from odometry poses are not that good.
-  // Its best direction is capped at loop_sigma_rotation (rows and columns scaled alike, so the
-  // matrix stays positive semi-definite).
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rotation(scaled.bottomRightCorner<3, 3>());
-  const double rotation_cap = 1.0 / (options_.loop_sigma_rotation * options_.loop_sigma_rotation);
-  if (rotation.eigenvalues()(2) > rotation_cap) {
-    Vector6d d = Vector6d::Ones();
-    d.tail<3>().setConstant(std::sqrt(rotation_cap / rotation.eigenvalues()(2)));
-    scaled = d.asDiagonal() * scaled * d.asDiagonal();
-  }
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(scaled);
-  if (eigen.info() != Eigen::Success) return fallback;
-  const double floor = 1e-6 * eigen.eigenvalues().maxCoeff();
-  const Vector6d values = eigen.eigenvalues().cwiseMax(floor);
-  if (!(floor > 0.0) || !values.allFinite()) return fallback;
-  const Matrix6d information =
-      eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
-  return 0.5 * (information + information.transpose());
+  // A submap match's rotation block claims tens of metres of lever arm: capped (see
+  // shaped_loop_information).
+  return shaped_loop_information<3>(
+      hessian, options_.loop_sigma_translation, options_.loop_sigma_rotation,
+      diagonal_information(options_.loop_sigma_translation, options_.loop_sigma_rotation));
 }
 
 void LoopClosure3D::optimize() {
