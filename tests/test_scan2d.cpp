@@ -347,6 +347,7 @@ TEST(Scan2D, BadInputGivesClearErrors) {
   refused([](Registration2DOptions& b) { b.sparse_keep_fraction = 0.0; });
   refused([](Registration2DOptions& b) { b.keep_fraction = 1.5; });
   refused([](Registration2DOptions& b) { b.sparse_min_pairs = 1.0; });
+  refused([](Registration2DOptions& b) { b.search_fill_gap = -1.0; });
   for (const auto shared :
        {PathRules::Shared::drop, PathRules::Shared::keep_nearest, PathRules::Shared::keep_all})
     EXPECT_EQ(parse_shared_rows(to_string(shared)), shared);
@@ -440,6 +441,20 @@ TEST(Map2D, WideSearchFindsATurnBeyondTheSearchAngle) {
   config.wide_search_angle = 0.0;
   const Pose2 narrow = second_pose(config);
   EXPECT_GT(std::abs(degrees(pose2_angle(narrow)) - 75.0), 20.0);
+}
+
+TEST(Map2D, MapperRefusesOptionsOutOfRangeBeforeTheFirstScan) {
+  // Caught per scan, they would bridge every scan silently instead.
+  const auto refused = [](auto change) {
+    Mapper2DConfig config;
+    change(config);
+    EXPECT_THROW(Mapper2D{config}, Error);
+  };
+  refused([](Mapper2DConfig& c) { c.registration.search_fill_gap = -1.0; });
+  refused([](Mapper2DConfig& c) { c.registration.keep_fraction = 1.5; });
+  refused([](Mapper2DConfig& c) { c.registration.method = "no-such-method"; });
+  refused([](Mapper2DConfig& c) { c.wide_search_angle = -0.1; });
+  EXPECT_NO_THROW(Mapper2D{Mapper2DConfig{}});
 }
 
 TEST(Map2D, DeskewingStaysStableOnADistortedSequence) {

@@ -10,7 +10,9 @@
 namespace scanmatch {
 
 Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
-  check_registration_2d_method(config.registration.method);
+  check_registration_2d_options(config.registration);
+  if (!(config.wide_search_angle >= 0.0) || !(config.wide_search_below >= 0.0))
+    throw Error("map2d: wide_search_angle and wide_search_below must not be negative");
 }
 
 bool Mapper2D::plausible_correction(const Pose2& correction) const {

@@ -20,26 +20,6 @@ void check_scan(const Scan2D& scan, const char* which, std::size_t min_points) {
       throw Error(std::string("2D registration: the ") + which + " scan has a non-finite point");
 }
 
-void check_options(const Registration2DOptions& o) {
-  if (!(o.max_correspondence_distance > 0.0))
-    throw Error("2D registration: the correspondence distance must be positive");
-  if (o.max_iterations < 1) throw Error("2D registration: at least one iteration is needed");
-  if (o.sparse_step != "svd" && o.sparse_step != "point-to-line")
-    throw Error("2D registration: unknown sparse-icp step '" + o.sparse_step +
-                "' (svd, point-to-line)");
-  if (o.path_rules.max_step < 1 || o.path_rules.max_run < 1)
-    throw Error("2D registration: the path's max step and max run must be at least 1");
-  if (!(o.sparse_line_radius >= 0.0) || !(o.pl_line_radius >= 0.0))
-    throw Error("2D registration: a line radius must be 0 or positive");
-  if (!(o.sparse_keep_fraction > 0.0 && o.sparse_keep_fraction <= 1.0) ||
-      !(o.keep_fraction > 0.0 && o.keep_fraction <= 1.0))
-    throw Error("2D registration: a keep fraction must be in (0, 1]");
-  if (!(o.sparse_min_pairs >= 0.0 && o.sparse_min_pairs < 1.0))
-    throw Error("2D registration: sparse_min_pairs must be in [0, 1)");
-  if (!(o.search_fill_gap >= 0.0))
-    throw Error("2D registration: search_fill_gap must not be negative");
-}
-
 }  // namespace
 
 const std::vector<Registration2DMethod>& registration_2d_methods() {
@@ -83,10 +63,31 @@ void check_registration_2d_method(const std::string& method) {
   registration_2d_method(method);
 }
 
+void check_registration_2d_options(const Registration2DOptions& o) {
+  check_registration_2d_method(o.method);
+  if (!(o.max_correspondence_distance > 0.0))
+    throw Error("2D registration: the correspondence distance must be positive");
+  if (o.max_iterations < 1) throw Error("2D registration: at least one iteration is needed");
+  if (o.sparse_step != "svd" && o.sparse_step != "point-to-line")
+    throw Error("2D registration: unknown sparse-icp step '" + o.sparse_step +
+                "' (svd, point-to-line)");
+  if (o.path_rules.max_step < 1 || o.path_rules.max_run < 1)
+    throw Error("2D registration: the path's max step and max run must be at least 1");
+  if (!(o.sparse_line_radius >= 0.0) || !(o.pl_line_radius >= 0.0))
+    throw Error("2D registration: a line radius must be 0 or positive");
+  if (!(o.sparse_keep_fraction > 0.0 && o.sparse_keep_fraction <= 1.0) ||
+      !(o.keep_fraction > 0.0 && o.keep_fraction <= 1.0))
+    throw Error("2D registration: a keep fraction must be in (0, 1]");
+  if (!(o.sparse_min_pairs >= 0.0 && o.sparse_min_pairs < 1.0))
+    throw Error("2D registration: sparse_min_pairs must be in [0, 1)");
+  if (!(o.search_fill_gap >= 0.0))
+    throw Error("2D registration: search_fill_gap must not be negative");
+}
+
 Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
                                     const Registration2DOptions& o, const Pose2& initial) {
   const Registration2DMethod& method = registration_2d_method(o.method);
-  check_options(o);
+  check_registration_2d_options(o);
   check_scan(current, "current", method.min_points);
   check_scan(reference, "reference", method.min_points);
   const Pose2 start =

@@ -123,6 +123,9 @@ std::string registration_2d_method_list();
 const Registration2DMethod& registration_2d_method(const std::string& name);
 /// Throws Error naming the valid methods unless `method` is one of them.
 void check_registration_2d_method(const std::string& method);
+/// Throws Error naming the problem unless the method is known and every option is in range (what
+/// register_scans checks first; long runs check once before their first scan).
+void check_registration_2d_options(const Registration2DOptions& options);
 
 /// Registers `current` onto `reference` from `initial` (after the correlative search, when
 /// `search_window` is set). Throws Error for an unknown method, options out of range, or scans
