@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics2d.hpp"
 #include "scanmatch/mapping/loop_closure2d.hpp"
 #include "scanmatch/odometry/mapper2d.hpp"
@@ -154,6 +155,19 @@ TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
   EXPECT_TRUE(unchecked.accepted) << unchecked.paired_fraction << " " << unchecked.constraint;
   EXPECT_FALSE(checked.accepted);
   EXPECT_GT(checked.shifted_fraction, 0.8);
+}
+
+TEST(LoopClosure2D, OptionsOutOfRangeAreRefused) {
+  const auto refused = [](auto change) {
+    LoopClosure2DOptions o;
+    change(o);
+    EXPECT_THROW(LoopClosure2D{o}, Error);
+  };
+  refused([](LoopClosure2DOptions& o) { o.loop_sigma_xy = 0.0; });
+  refused([](LoopClosure2DOptions& o) { o.keyframe_distance = -1.0; });
+  refused([](LoopClosure2DOptions& o) { o.verification.max_shifted_fraction = -0.5; });
+  refused([](LoopClosure2DOptions& o) { o.verification.method = "no-such-method"; });
+  EXPECT_NO_THROW(LoopClosure2D{LoopClosure2DOptions{}});
 }
 
 TEST(LoopClosure2D, VerificationRejectsTwoDifferentPlaces) {

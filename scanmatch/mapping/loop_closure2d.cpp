@@ -249,6 +249,8 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error("loop closure: pair distance, search window and resolution must be positive");
   if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
     throw Error("loop closure: keyframe thresholds must not be negative");
+  if (!(options.verification.max_shifted_fraction >= 0.0))
+    throw Error("loop closure: max_shifted_fraction must not be negative (0: not checked)");
   options_.search_every = std::max<std::size_t>(options_.search_every, 1);
 }
 
