@@ -166,6 +166,7 @@ TEST(LoopClosure2D, OptionsOutOfRangeAreRefused) {
   refused([](LoopClosure2DOptions& o) { o.loop_sigma_xy = 0.0; });
   refused([](LoopClosure2DOptions& o) { o.keyframe_distance = -1.0; });
   refused([](LoopClosure2DOptions& o) { o.verification.max_shifted_fraction = -0.5; });
+  refused([](LoopClosure2DOptions& o) { o.verification.min_search_score = 1.2; });
   refused([](LoopClosure2DOptions& o) { o.verification.method = "no-such-method"; });
   EXPECT_NO_THROW(LoopClosure2D{LoopClosure2DOptions{}});
 }
@@ -180,6 +181,7 @@ TEST(LoopClosure2D, VerificationRejectsTwoDifferentPlaces) {
   EXPECT_TRUE(same.accepted) << same.paired_fraction << " " << same.error << " "
                              << same.free_violations;
   EXPECT_LT(same.transform.translation().norm(), 0.02);
+  EXPECT_GT(same.search_score, 0.8);
   // A scan in a room against scans in the hallway (the rooms are identical copies, so only a
   // room against the hallway is surely two different places): every guess the candidate sources
   // could give (the identity, and the descriptor's best yaw) must be rejected.

@@ -303,6 +303,32 @@ TEST(Scan2D, CorrelativeSearchBridgesALargeStep) {
   EXPECT_LT((r.transform.translation() - truth.translation()).norm(), 0.01);
 }
 
+TEST(Scan2D, CorrelativeMatchScoresTheFitAndGivesUpBelowItsMinimum) {
+  const Scan2D reference = room_scan(pose2(2.0, 1.5, 0.0));
+  const Pose2 truth = pose2(0.4, 0.3, -0.2);
+  const Scan2D current = room_scan(pose2(2.0, 1.5, 0.0) * truth);
+  const CorrelativeMatch match =
+      correlative_match(current, reference, Pose2::Identity(), 1.0, 0.5, 0.05, 0.0, 0.5);
+  ASSERT_TRUE(match.found);
+  EXPECT_GT(match.score, 0.7);  // the same room: every point on a wall (up to the grid)
+  EXPECT_LE(match.score, 1.0);
+  EXPECT_TRUE(match.pose.isApprox(
+      correlative_search(current, reference, Pose2::Identity(), 1.0, 0.5), 1e-12));
+  EXPECT_LT((match.pose.translation() - truth.translation()).norm(), 0.06);
+  // Against one wall of the room most of the scan fits nowhere: below a minimum of 0.4 the
+  // search gives up and hands back the guess.
+  Scan2D wall;
+  for (const Vec2& p : reference.points)
+    if (std::abs(p.y() + 1.5) < 1e-6) wall.points.push_back(p);  // the wall along world y = 0
+  ASSERT_GE(wall.points.size(), 3u);
+  const Pose2 guess = pose2(0.1, 0.0, 0.0);
+  const CorrelativeMatch none = correlative_match(current, wall, guess, 1.0, 0.5, 0.05, 0.0, 0.4);
+  EXPECT_FALSE(none.found);
+  EXPECT_TRUE(none.pose.isApprox(guess));
+  EXPECT_LT(correlative_match(current, wall, guess, 1.0, 0.5).score, 0.4) << "one wall of six";
+  EXPECT_THROW(correlative_match(current, reference, guess, 1.0, 0.5, 0.05, 0.0, 1.5), Error);
+}
+
 TEST(Scan2D, FilledSurfacesJoinAGrazingWallButNotADepthJump) {
   // A wall along y = 1 seen at a grazing angle (samples 1 to 4 m apart), then a jump to a far
   // wall along y = 6: the search's reference fills the first, never the gap between the two.

@@ -190,20 +190,21 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
     return out;
   Registration2DOptions r;
   r.method = options.method;
-  r.search_window = options.search_window;
-  r.search_angle = options.search_angle;
-  r.search_resolution = options.search_resolution;
   r.max_correspondence_distance = options.max_correspondence_distance;
+  r.search_window = 0.0;  // searched here, so that a place nothing fits ends the check early
+  const Scan2D& reference_scan = candidate_submap ? *candidate_submap : candidate;
   try {
-    out.transform =
-        register_scans(current, candidate_submap ? *candidate_submap : candidate, r, initial)
-            .transform;
+    const CorrelativeMatch match = correlative_match(
+        current, reference_scan, initial, options.search_window, options.search_angle,
+        options.search_resolution, r.search_fill_gap, options.min_search_score);
+    out.search_score = match.score;
+    if (!match.found) return out;
+    out.transform = register_scans(current, reference_scan, r, match.pose).transform;
   } catch (const Error&) {
     return out;  // too few usable points for the method: not verifiable, so not a loop
   }
   if (!out.transform.matrix().allFinite()) return out;
-  const OverlapTarget reference(candidate_submap ? *candidate_submap : candidate,
-                                options.pair_distance, r.search_fill_gap);
+  const OverlapTarget reference(reference_scan, options.pair_distance, r.search_fill_gap);
   const OverlapCheck forward =
       check_overlap(current, reference, out.transform, options.free_margin);
   const OverlapCheck backward =
@@ -249,6 +250,9 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error("loop closure: pair distance, search window and resolution must be positive");
   if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
     throw Error("loop closure: keyframe thresholds must not be negative");
+  if (!(options.verification.min_search_score >= 0.0 &&
+        options.verification.min_search_score <= 1.0))
+    throw Error("loop closure: min_search_score must be in [0, 1]");
   if (!(options.verification.max_shifted_fraction >= 0.0))
     throw Error("loop closure: max_shifted_fraction must not be negative (0: not checked)");
   options_.search_every = std::max<std::size_t>(options_.search_every, 1);

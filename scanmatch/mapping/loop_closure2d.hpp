@@ -31,6 +31,11 @@ struct LoopVerification2DOptions {
   double search_angle = 30.0 * M_PI / 180;
   /// m; 0.1 found the same loops on the CARMEN logs as 0.05, 3.6x faster (the fine stage refines).
   double search_resolution = 0.1;
+  /// The search gives up (rejects) where no pose scores this share of its best possible
+  /// (correlative_match): most candidates show another place, and ending their search early
+  /// halves loop closure's time. Accepted loops on the CARMEN logs scored 0.39 to 1 (5 % below
+  /// 0.54 to 0.60); 0: every candidate is searched through.
+  double min_search_score = 0.5;
   double max_correspondence_distance = 0.3;  ///< m, of the fine stage
   /// A current point is paired when a candidate point lies within this distance after the
   /// registration, m.
@@ -67,6 +72,7 @@ struct LoopVerification2D {
   double error = 0.0;            ///< m, mean distance of the paired points
   double free_violations = 0.0;  ///< share of points in the other scan's free space (worst way)
   double constraint = 0.0;       ///< the weaker direction's share of the normals (worst way)
+  double search_score = 0.0;     ///< the correlative search's best score (share of its best)
   /// Gauss-Newton Hessian of the current scan's paired point-to-line distances at `transform`, in
   /// (x, y, theta) of the current scan's frame (unscaled: the information's shape).
   Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();

@@ -297,6 +297,8 @@ void describe(LoopVerification2DOptions& o, Visitor& v) {
   v("search_window", o.search_window, nullptr, "Correlative search, +- m around the candidate");
   v("search_angle", o.search_angle, nullptr, "Correlative search, +- rad");
   v("search_resolution", o.search_resolution, nullptr, "Correlative search cell size, m");
+  v("min_search_score", o.min_search_score, nullptr,
+    "Reject where no pose of the search scores this share of its best (0: search through)");
   v("max_correspondence_distance", o.max_correspondence_distance, nullptr,
     "Fine stage's correspondence distance, m");
   v("pair_distance", o.pair_distance, nullptr, "A point is paired within this distance, m");

@@ -1,6 +1,7 @@
 #include "scanmatch/registration/planar/correlative_search.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -14,24 +15,31 @@ namespace {
 
 using Vec2 = Eigen::Vector2d;
 
-constexpr int kBlock = 8;  ///< translations per block side in the coarse level
+/// Block sides of the branch and bound's levels: each level's cell bounds the 4 x 4 cells of the
+/// level below it (`kBranch` per side).
+constexpr int kBranch = 4;
+constexpr int kLevels = 4;  ///< sides 1, 4, 16, 64
+constexpr int kTopSide = 64;
 constexpr std::int64_t kMaxCells = 16'000'000;
 
 struct LikelihoodGrid {
   double resolution = 0.05;
   Vec2 origin = Vec2::Zero();  ///< world position of cell (0, 0)'s corner
   int width = 0, height = 0;
-  std::vector<float> fine, block_max;  ///< block_max(x, y) = max of fine over [x, x+B) x [y, y+B)
+  /// levels[0] is the smoothed likelihood; levels[k](x, y) = max of levels[0] over the square of
+  /// side kBranch^k from (x, y) towards +x and +y.
+  std::vector<std::vector<float>> levels;
 
-  float at(const std::vector<float>& g, int x, int y) const {
+  float at(int level, int x, int y) const {
     if (x < 0 || y < 0 || x >= width || y >= height) return 0.0f;
-    return g[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-             static_cast<std::size_t>(x)];
+    return levels[static_cast<std::size_t>(level)]
+                 [static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                  static_cast<std::size_t>(x)];
   }
 };
 
 /// The grid spans the reference points only: a current point landing elsewhere scores nothing.
-/// Below them it reaches one block further, so that block_max bounds the blocks that start
+/// Below them it reaches one top block further, so that the levels bound the blocks that start
 /// outside (`g.at` is zero off the grid). Coarser cells where the area is huge, so memory stays
 /// bounded.
 LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) {
@@ -43,17 +51,24 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
   }
   const auto cells = [&](double r) {
     const Vec2 size = high - low;
-    return (size.x() / r + kBlock + 6) * (size.y() / r + kBlock + 6);
+    return (size.x() / r + kTopSide + 6) * (size.y() / r + kTopSide + 6) * kLevels;
   };
   while (cells(resolution) > static_cast<double>(kMaxCells)) resolution *= 2;
-  low -= Vec2::Constant((kBlock + 3) * resolution);
+  low -= Vec2::Constant((kTopSide + 3) * resolution);
   high += Vec2::Constant(3 * resolution);
   const Vec2 size = high - low;
   g.resolution = resolution;
   g.origin = low;
   g.width = static_cast<int>(std::ceil(size.x() / resolution)) + 1;
   g.height = static_cast<int>(std::ceil(size.y() / resolution)) + 1;
-  g.fine.assign(static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height), 0.0f);
+  const std::size_t n = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
+  g.levels.assign(kLevels, {});
+  std::vector<float>& fine = g.levels[0];
+  fine.assign(n, 0.0f);
+  const auto index = [&](int x, int y) {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) +
+           static_cast<std::size_t>(x);
+  };
   // Gaussian of sigma = one cell around each reference point, out to two cells.
   const int radius = 2;
   float kernel[2 * radius + 1][2 * radius + 1];
@@ -67,28 +82,39 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
       for (int dx = -radius; dx <= radius; ++dx) {
         const int x = cx + dx, y = cy + dy;
         if (x < 0 || y < 0 || x >= g.width || y >= g.height) continue;
-        float& cell = g.fine[static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) +
-                             static_cast<std::size_t>(x)];
+        float& cell = fine[index(x, y)];
         cell = std::max(cell, kernel[dy + radius][dx + radius]);
       }
   }
-  // Separable sliding maximum over kBlock cells towards +x, then +y.
-  std::vector<float> rows(g.fine.size());
-  for (int y = 0; y < g.height; ++y)
-    for (int x = 0; x < g.width; ++x) {
-      float m = 0.0f;
-      for (int k = 0; k < kBlock && x + k < g.width; ++k) m = std::max(m, g.at(g.fine, x + k, y));
-      rows[static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) +
-           static_cast<std::size_t>(x)] = m;
+  // Each level from the one below: the maximum of kBranch cells `stride` apart along +x, then
+  // +y. Off the grid counts as zero; written branch-free over whole rows so that it vectorizes.
+  const std::size_t width = static_cast<std::size_t>(g.width);
+  std::vector<float> rows(n);
+  std::size_t stride = 1;
+  for (std::size_t level = 1; level < kLevels; ++level, stride *= kBranch) {
+    const std::vector<float>& below = g.levels[level - 1];
+    for (std::size_t y = 0; y < static_cast<std::size_t>(g.height); ++y) {
+      const float* in = below.data() + y * width;
+      float* out = rows.data() + y * width;
+      std::copy(in, in + width, out);
+      for (std::size_t k = 1; k < kBranch && k * stride < width; ++k) {
+        const float* shifted = in + k * stride;
+        const std::size_t count = width - k * stride;
+        for (std::size_t x = 0; x < count; ++x) out[x] = std::max(out[x], shifted[x]);
+      }
     }
-  g.block_max.assign(g.fine.size(), 0.0f);
-  for (int y = 0; y < g.height; ++y)
-    for (int x = 0; x < g.width; ++x) {
-      float m = 0.0f;
-      for (int k = 0; k < kBlock && y + k < g.height; ++k) m = std::max(m, g.at(rows, x, y + k));
-      g.block_max[static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) +
-                  static_cast<std::size_t>(x)] = m;
+    std::vector<float>& out = g.levels[level];
+    out = rows;
+    for (std::size_t y = 0; y < static_cast<std::size_t>(g.height); ++y) {
+      float* row = out.data() + y * width;
+      for (std::size_t k = 1; k < kBranch; ++k) {
+        const std::size_t other = y + k * stride;
+        if (other >= static_cast<std::size_t>(g.height)) break;
+        const float* in = rows.data() + other * width;
+        for (std::size_t x = 0; x < width; ++x) row[x] = std::max(row[x], in[x]);
+      }
     }
+  }
   return g;
 }
 
@@ -142,9 +168,20 @@ std::vector<Vec2> filled_surfaces(const Scan2D& scan, double max_gap, double ste
 
 Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
                          double window, double angle_window, double resolution, double fill_gap) {
+  return correlative_match(current, reference, initial, window, angle_window, resolution, fill_gap)
+      .pose;
+}
+
+CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& reference,
+                                   const Pose2& initial, double window, double angle_window,
+                                   double resolution, double fill_gap, double min_score) {
   if (!(window > 0.0) || !(angle_window >= 0.0) || !(resolution > 0.0))
     throw Error("correlative search: window and resolution must be positive");
-  if (current.points.empty() || reference.points.empty()) return initial;
+  if (!(min_score >= 0.0 && min_score <= 1.0))
+    throw Error("correlative search: the minimum score must be in [0, 1]");
+  CorrelativeMatch match;
+  match.pose = initial;
+  if (current.points.empty() || reference.points.empty()) return match;
   const std::vector<Vec2> points = thinned(current.points, 2 * resolution);
 
   // The grid covers where the current scan can land: its footprint under the initial guess,
@@ -174,7 +211,7 @@ Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const P
   std::vector<Vec2> useful;
   for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
     if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
-  if (useful.empty()) return initial;
+  if (useful.empty()) return match;
   const LikelihoodGrid g = make_grid(useful, resolution);
   const double r = g.resolution;
 
@@ -185,57 +222,118 @@ Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const P
   const int half = static_cast<int>(std::ceil(window / r));  // translations -half..half cells
   const double theta0 = pose2_angle(initial);
 
-  struct Candidate {
-    float bound;
-    int angle, bx, by;  ///< block corner, in translation cells relative to -half
-  };
-  std::vector<Candidate> candidates;
+  // Cells of the thinned points under each rotation, relative to the window's corner.
   std::vector<std::vector<std::pair<int, int>>> cells(static_cast<std::size_t>(2 * angles + 1));
   const int span = 2 * half + 1;
+  // floor() through a shift into positive numbers (a plain conversion truncates): far cheaper
+  // than std::floor, exact for cells within 2^20 of the grid.
+  constexpr double kShift = 1 << 20;
+  const auto cell = [&](double v) { return static_cast<int>(v + kShift) - (1 << 20) - half; };
+  const Vec2 start = (initial.translation() - g.origin) / r;
   for (int a = -angles; a <= angles; ++a) {
-    const Pose2 T =
-        pose2(initial.translation().x(), initial.translation().y(), theta0 + a * angle_step);
-    auto& c = cells[static_cast<std::size_t>(a + angles)];
-    c.reserve(points.size());
-    for (const Vec2& p : points) {
-      const Vec2 q = (T * p - g.origin) / r;
-      c.push_back(
-          {static_cast<int>(std::floor(q.x())) - half, static_cast<int>(std::floor(q.y())) - half});
-    }
-    for (int by = 0; by < span; by += kBlock)
-      for (int bx = 0; bx < span; bx += kBlock) {
-        float bound = 0.0f;
-        for (const auto& [x, y] : c) bound += g.at(g.block_max, x + bx, y + by);
-        candidates.push_back({bound, a, bx, by});
-      }
+    const double theta = theta0 + a * angle_step;
+    const double c = std::cos(theta) / r, s = std::sin(theta) / r;
+    auto& out = cells[static_cast<std::size_t>(a + angles)];
+    out.reserve(points.size());
+    for (const Vec2& p : points)
+      out.push_back(
+          {cell(c * p.x() - s * p.y() + start.x()), cell(s * p.x() + c * p.y() + start.y())});
   }
-  std::sort(candidates.begin(), candidates.end(),
-            [](const Candidate& a, const Candidate& b) { return a.bound > b.bound; });
-  // Exact at the fine level: a block whose bound cannot beat the best score so far is skipped,
-  // and so is everything after it (sorted). Ties go to the translation nearest the guess.
-  float best = -1.0f;
+  // Branch and bound, depth first: a block of translations is bounded by its level's maxima; the
+  // children of the most promising blocks are looked at first, so the best score found early
+  // dismisses most of the window. Exact at the finest level; ties go to the translation nearest
+  // the guess.
+  struct Block {
+    float bound;
+    int angle, level, x, y;  ///< corner, in translation cells relative to -half
+  };
+  const auto bound_of = [&](int angle, int level, int x, int y) {
+    float sum = 0.0f;
+    for (const auto& [cx, cy] : cells[static_cast<std::size_t>(angle + angles)])
+      sum += g.at(level, cx + x, cy + y);
+    return Block{sum, angle, level, x, y};
+  };
+  const auto by_bound = [](const Block& a, const Block& b) { return a.bound > b.bound; };
+  // The top level: the coarsest whose blocks still split the window.
+  int top = kLevels - 1, top_side = kTopSide;
+  while (top > 0 && top_side / kBranch >= span) {
+    --top;
+    top_side /= kBranch;
+  }
+  std::vector<Block> blocks;
+  for (int a = -angles; a <= angles; ++a)
+    for (int y = 0; y < span; y += top_side)
+      for (int x = 0; x < span; x += top_side) blocks.push_back(bound_of(a, top, x, y));
+  std::sort(blocks.begin(), blocks.end(), by_bound);
+  // Below the minimum nothing counts, so the bounds prune from the start.
+  float best = static_cast<float>(min_score * static_cast<double>(points.size()));
   int best_a = 0, best_x = half, best_y = half;
   double best_offset = std::numeric_limits<double>::infinity();
-  for (const Candidate& cand : candidates) {
-    if (cand.bound < best) break;
-    const auto& c = cells[static_cast<std::size_t>(cand.angle + angles)];
-    for (int ty = cand.by; ty < std::min(cand.by + kBlock, span); ++ty)
-      for (int tx = cand.bx; tx < std::min(cand.bx + kBlock, span); ++tx) {
-        float score = 0.0f;
-        for (const auto& [x, y] : c) score += g.at(g.fine, x + tx, y + ty);
-        if (score < best) continue;
-        const double offset = std::hypot(tx - half, ty - half) + std::abs(cand.angle);
-        if (score > best || offset < best_offset) {
-          best = score;
-          best_offset = offset;
-          best_a = cand.angle;
-          best_x = tx;
-          best_y = ty;
-        }
-      }
+  // A pose's exact score at the finest level; kept when it beats the best so far, or ties it
+  // nearer the guess.
+  const auto consider = [&](const Block& leaf) {
+    if (leaf.bound < best) return false;
+    const double offset = std::hypot(leaf.x - half, leaf.y - half) + std::abs(leaf.angle);
+    if (leaf.bound == best && offset >= best_offset) return false;
+    best = leaf.bound;
+    best_offset = offset;
+    best_a = leaf.angle;
+    best_x = leaf.x;
+    best_y = leaf.y;
+    return true;
+  };
+  // A good score early prunes most of the tree: climb from the guess (where odometry's constant
+  // velocity guess and a loop's estimate usually lie close) before branching.
+  {
+    int a = 0, x = half, y = half;
+    consider(bound_of(a, 0, x, y));
+    for (int step = 0; step < 32; ++step) {
+      Block up = bound_of(a, 0, x, y);
+      for (int da = -1; da <= 1; ++da)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int na = a + da, nx = x + dx, ny = y + dy;
+            if (std::abs(na) > angles || nx < 0 || ny < 0 || nx >= span || ny >= span) continue;
+            const Block b = bound_of(na, 0, nx, ny);
+            consider(b);
+            if (b.bound > up.bound) up = b;
+          }
+      if (up.angle == a && up.x == x && up.y == y) break;
+      a = up.angle;
+      x = up.x;
+      y = up.y;
+    }
   }
-  return pose2(initial.translation().x() + (best_x - half) * r,
-               initial.translation().y() + (best_y - half) * r, theta0 + best_a * angle_step);
+  const auto descend = [&](const auto& self, const Block& block) -> void {
+    if (block.level == 0) {
+      consider(block);
+      return;
+    }
+    int side = 1;
+    for (int k = 1; k < block.level; ++k) side *= kBranch;
+    std::array<Block, kBranch * kBranch> next;
+    std::size_t count = 0;
+    for (int dy = 0; dy < kBranch; ++dy)
+      for (int dx = 0; dx < kBranch; ++dx) {
+        const int x = block.x + dx * side, y = block.y + dy * side;
+        if (x < span && y < span) next[count++] = bound_of(block.angle, block.level - 1, x, y);
+      }
+    std::sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(count), by_bound);
+    for (std::size_t i = 0; i < count; ++i) {
+      if (next[i].bound < best) break;
+      self(self, next[i]);
+    }
+  };
+  for (const Block& block : blocks) {
+    if (block.bound < best) break;
+    descend(descend, block);
+  }
+  if (!std::isfinite(best_offset)) return match;  // nothing reached the minimum score
+  match.found = true;
+  match.score = best / static_cast<double>(points.size());
+  match.pose = pose2(initial.translation().x() + (best_x - half) * r,
+                     initial.translation().y() + (best_y - half) * r, theta0 + best_a * angle_step);
+  return match;
 }
 
 }  // namespace scanmatch

@@ -1,8 +1,9 @@
 #pragma once
-// Correlative scan matching over a window (Olson's idea, our own two-level branch and bound): the
+// Correlative scan matching over a window (Olson's idea, our own multi-level branch and bound): the
 // reference becomes a smoothed likelihood grid; each rotation of the current scan is scored at
-// every translation of the window. A max-filtered copy of the grid bounds the score of a whole
-// block of translations, so most blocks are dismissed without looking at their cells.
+// every translation of the window. Max-filtered copies of the grid (blocks of 4, 16 and 64 cells
+// a side) bound the score of a whole block of translations; the most promising blocks are split
+// first, so most of the window is dismissed without looking at its cells.
 // register_scans runs it first when Registration2DOptions::search_window is set.
 
 #include "scanmatch/core/scan2d.hpp"
@@ -18,6 +19,22 @@ namespace scanmatch {
 Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
                          double window, double angle_window, double resolution = 0.05,
                          double fill_gap = 0.0);
+
+struct CorrelativeMatch {
+  Pose2 pose = Pose2::Identity();  ///< the best pose, or the initial guess when not `found`
+  /// The best pose's score as a share of the best possible (every point of the thinned current
+  /// scan on a reference surface): 0 to 1.
+  double score = 0.0;
+  bool found = false;  ///< false when no pose reaches `min_score`
+};
+
+/// correlative_search that also reports the score and gives up on poses scoring below `min_score`
+/// (a share, 0 to 1): a search for a pose that must fit well (a loop closure's) prunes from the
+/// start and ends early where nothing fits.
+CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& reference,
+                                   const Pose2& initial, double window, double angle_window,
+                                   double resolution = 0.05, double fill_gap = 0.0,
+                                   double min_score = 0.0);
 
 /// The scan's points plus points every `step` (m) between beam neighbours up to `max_gap` apart
 /// that lie on one straight surface (a third neighbour on their line). Two scans sample a wall
