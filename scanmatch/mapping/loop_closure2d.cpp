@@ -250,6 +250,8 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error("loop closure: pair distance, search window and resolution must be positive");
   if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
     throw Error("loop closure: keyframe thresholds must not be negative");
+  if (!(options.optimize_above >= 0.0))
+    throw Error("loop closure: optimize_above must not be negative");
   if (!(options.verification.min_search_score >= 0.0 &&
         options.verification.min_search_score <= 1.0))
     throw Error("loop closure: min_search_score must be in [0, 1]");
@@ -337,7 +339,7 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
       if (!known) candidates.emplace_back(c.index, pose2(0.0, 0.0, c.yaw));
     }
   }
-  bool added = false;
+  bool stale = false;
   for (const auto& [k, initial] : candidates) {
     ++counts_.candidates;
     Scan2D submap;
@@ -369,6 +371,10 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
       continue;
     }
     ++counts_.verified;
+    // How far the loop would move the keyframe's points at 5 m from the current estimate.
+    const Pose2 mismatch = estimated.inverse() * v.transform;
+    const double moved = mismatch.translation().norm() + 5.0 * std::abs(pose2_angle(mismatch));
+    if (moved >= options_.optimize_above) stale = true;
     Loop2D loop;
     loop.from_keyframe = k;
     loop.to_keyframe = keyframe;
@@ -378,9 +384,8 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
     loop.paired_fraction = v.paired_fraction;
     loop.error = v.error;
     graph_.add_loop(loop, loop_information(v.hessian));
-    added = true;
   }
-  if (added) optimize();
+  if (stale) optimize();
 }
 
 Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) const {
@@ -399,7 +404,7 @@ void LoopClosure2D::optimize() {
 
 void LoopClosure2D::finish() {
   const auto start = std::chrono::steady_clock::now();
-  if (!loops().empty()) optimize();
+  if (!loops().empty()) optimize();  // also the loops that agreed with the estimate when added
   counts_.total_ms += elapsed_ms(start);
 }
 
