@@ -1,0 +1,63 @@
+// Correlative search micro-benchmarks on simulated office scans (sim:corridor-2d, no shared data
+// needed): the odometry's search (+-1.3 m, +-45 deg, 5 cm), its wide search (+-90 deg), and a
+// loop verification's search (+-2 m, +-30 deg, 10 cm) of a scan against one 20 scans away, with
+// and without the minimum score that lets a search of a place that does not fit end early.
+//   build/bench/scanmatch_bench --benchmark_filter=CorrelativeSearch
+
+#include <benchmark/benchmark.h>
+
+#include "scanmatch/odometry/run2d.hpp"
+#include "scanmatch/registration/planar/correlative_search.hpp"
+
+namespace {
+using namespace scanmatch;
+
+const std::vector<Scan2D>& scans() {
+  static const std::vector<Scan2D> out = [] {
+    SequenceOptions o;
+    o.simulator.motion_distortion = false;
+    const Scans2D input = load_scans_2d("sim:corridor-2d", o, 60);
+    std::vector<Scan2D> s;
+    for (const LaserScan2D& scan : input.scans) s.push_back(scan_from_laser(scan, 0.05));
+    return s;
+  }();
+  return out;
+}
+
+// Pairs `gap` scans apart from the identity, over the first 40 scans.
+void run(benchmark::State& state, std::size_t gap, double window, double angle, double resolution,
+         double min_score) {
+  const std::vector<Scan2D>& s = scans();
+  std::size_t found = 0, searches = 0;
+  for (auto _ : state)
+    for (std::size_t i = 0; i + gap < s.size() && i < 40; i += 4) {
+      const CorrelativeMatch m = correlative_match(s[i + gap], s[i], Pose2::Identity(), window,
+                                                   angle, resolution, 1.0, min_score);
+      found += m.found;
+      ++searches;
+    }
+  benchmark::DoNotOptimize(found);
+  state.SetItemsProcessed(static_cast<std::int64_t>(searches));
+}
+
+void BM_CorrelativeSearchOdometry(benchmark::State& state) {
+  run(state, 1, 1.3, 45 * M_PI / 180, 0.05, 0.0);
+}
+BENCHMARK(BM_CorrelativeSearchOdometry)->Unit(benchmark::kMillisecond);
+
+void BM_CorrelativeSearchOdometryWide(benchmark::State& state) {
+  run(state, 1, 1.3, 90 * M_PI / 180, 0.05, 0.0);
+}
+BENCHMARK(BM_CorrelativeSearchOdometryWide)->Unit(benchmark::kMillisecond);
+
+void BM_CorrelativeSearchLoopCandidate(benchmark::State& state) {
+  run(state, 20, 2.0, 30 * M_PI / 180, 0.1, 0.0);
+}
+BENCHMARK(BM_CorrelativeSearchLoopCandidate)->Unit(benchmark::kMillisecond);
+
+void BM_CorrelativeSearchLoopCandidateMinScore(benchmark::State& state) {
+  run(state, 20, 2.0, 30 * M_PI / 180, 0.1, 0.5);
+}
+BENCHMARK(BM_CorrelativeSearchLoopCandidateMinScore)->Unit(benchmark::kMillisecond);
+
+}  // namespace
