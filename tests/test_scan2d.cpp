@@ -315,6 +315,11 @@ TEST(Scan2D, CorrelativeMatchScoresTheFitAndGivesUpBelowItsMinimum) {
   EXPECT_TRUE(match.pose.isApprox(
       correlative_search(current, reference, Pose2::Identity(), 1.0, 0.5), 1e-12));
   EXPECT_LT((match.pose.translation() - truth.translation()).norm(), 0.06);
+  // A wild point (1e12 m) scores nowhere and changes nothing.
+  Scan2D wild = current;
+  wild.points.emplace_back(1e12, -1e12);
+  EXPECT_TRUE(correlative_match(wild, reference, Pose2::Identity(), 1.0, 0.5, 0.05, 0.0, 0.5)
+                  .pose.isApprox(match.pose, 1e-12));
   // Against one wall of the room most of the scan fits nowhere: below a minimum of 0.4 the
   // search gives up and hands back the guess.
   Scan2D wall;

@@ -226,9 +226,12 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   std::vector<std::vector<std::pair<int, int>>> cells(static_cast<std::size_t>(2 * angles + 1));
   const int span = 2 * half + 1;
   // floor() through a shift into positive numbers (a plain conversion truncates): far cheaper
-  // than std::floor, exact for cells within 2^20 of the grid.
+  // than std::floor, exact within 2^20 cells of the grid; farther (a wild point) is clamped, still
+  // off the grid, where a conversion would overflow.
   constexpr double kShift = 1 << 20;
-  const auto cell = [&](double v) { return static_cast<int>(v + kShift) - (1 << 20) - half; };
+  const auto cell = [&](double v) {
+    return static_cast<int>(std::clamp(v, -kShift, kShift) + kShift) - (1 << 20) - half;
+  };
   const Vec2 start = (initial.translation() - g.origin) / r;
   for (int a = -angles; a <= angles; ++a) {
     const double theta = theta0 + a * angle_step;
