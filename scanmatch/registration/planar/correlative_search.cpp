@@ -120,17 +120,25 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
 
 /// The current scan thinned to one point per cell: the score counts surface, not point density.
 std::vector<Vec2> thinned(const std::vector<Vec2>& points, double cell) {
-  std::vector<std::pair<std::int64_t, std::size_t>> keys;
+  // Cells as (x, y) pairs, clamped so that a wild coordinate cannot overflow the conversion.
+  const auto index = [&](double v) {
+    return static_cast<std::int64_t>(std::floor(std::clamp(v / cell, -1e15, 1e15)));
+  };
+  struct Key {
+    std::int64_t x, y;
+    std::size_t point;
+  };
+  std::vector<Key> keys;
   keys.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::int64_t x = static_cast<std::int64_t>(std::floor(points[i].x() / cell));
-    const std::int64_t y = static_cast<std::int64_t>(std::floor(points[i].y() / cell));
-    keys.push_back({x * 1'000'003 + y, i});
-  }
-  std::sort(keys.begin(), keys.end());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    keys.push_back({index(points[i].x()), index(points[i].y()), i});
+  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+    return a.x != b.x ? a.x < b.x : (a.y != b.y ? a.y < b.y : a.point < b.point);
+  });
   std::vector<Vec2> out;
   for (std::size_t k = 0; k < keys.size(); ++k)
-    if (k == 0 || keys[k].first != keys[k - 1].first) out.push_back(points[keys[k].second]);
+    if (k == 0 || keys[k].x != keys[k - 1].x || keys[k].y != keys[k - 1].y)
+      out.push_back(points[keys[k].point]);
   return out;
 }
 
