@@ -25,39 +25,28 @@ const std::vector<Scan2D>& scans() {
 }
 
 // Pairs `gap` scans apart from the identity, over the first 40 scans.
-void run(benchmark::State& state, std::size_t gap, double window, double angle, double resolution,
-         double min_score) {
+void BM_CorrelativeSearch(benchmark::State& state, std::size_t gap, double window, double angle_deg,
+                          double resolution, double min_score) {
   const std::vector<Scan2D>& s = scans();
   std::size_t found = 0, searches = 0;
   for (auto _ : state)
     for (std::size_t i = 0; i + gap < s.size() && i < 40; i += 4) {
-      const CorrelativeMatch m = correlative_match(s[i + gap], s[i], Pose2::Identity(), window,
-                                                   angle, resolution, 1.0, min_score);
+      const CorrelativeMatch m =
+          correlative_match(s[i + gap], s[i], Pose2::Identity(), window, angle_deg * M_PI / 180,
+                            resolution, 1.0, min_score);
       found += m.found;
       ++searches;
     }
   benchmark::DoNotOptimize(found);
   state.SetItemsProcessed(static_cast<std::int64_t>(searches));
 }
-
-void BM_CorrelativeSearchOdometry(benchmark::State& state) {
-  run(state, 1, 1.3, 45 * M_PI / 180, 0.05, 0.0);
-}
-BENCHMARK(BM_CorrelativeSearchOdometry)->Unit(benchmark::kMillisecond);
-
-void BM_CorrelativeSearchOdometryWide(benchmark::State& state) {
-  run(state, 1, 1.3, 90 * M_PI / 180, 0.05, 0.0);
-}
-BENCHMARK(BM_CorrelativeSearchOdometryWide)->Unit(benchmark::kMillisecond);
-
-void BM_CorrelativeSearchLoopCandidate(benchmark::State& state) {
-  run(state, 20, 2.0, 30 * M_PI / 180, 0.1, 0.0);
-}
-BENCHMARK(BM_CorrelativeSearchLoopCandidate)->Unit(benchmark::kMillisecond);
-
-void BM_CorrelativeSearchLoopCandidateMinScore(benchmark::State& state) {
-  run(state, 20, 2.0, 30 * M_PI / 180, 0.1, 0.5);
-}
-BENCHMARK(BM_CorrelativeSearchLoopCandidateMinScore)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CorrelativeSearch, odometry, 1, 1.3, 45.0, 0.05, 0.0)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CorrelativeSearch, odometry_wide, 1, 1.3, 90.0, 0.05, 0.0)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CorrelativeSearch, loop_candidate, 20, 2.0, 30.0, 0.1, 0.0)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CorrelativeSearch, loop_candidate_min_score, 20, 2.0, 30.0, 0.1, 0.5)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
