@@ -190,7 +190,6 @@ class LoopClosure2D {
   /// A loop edge's information: the verification's Hessian scaled to loop_sigma_xy in its best
   /// direction, the rotation capped at loop_sigma_theta (or the diagonal of both sigmas).
   Eigen::Matrix3d loop_information(const Eigen::Matrix3d& hessian) const;
-
   void optimize();
 
   LoopClosure2DOptions options_;

@@ -15,11 +15,13 @@ namespace {
 
 using Vec2 = Eigen::Vector2d;
 
-/// Block sides of the branch and bound's levels: each level's cell bounds the 4 x 4 cells of the
-/// level below it (`kBranch` per side).
+/// The branch and bound's levels: each level's cell bounds the kBranch x kBranch cells of the
+/// level below it, so level k's blocks have side kSides[k] = kBranch^k.
 constexpr int kBranch = 4;
-constexpr int kLevels = 4;  ///< sides 1, 4, 16, 64
-constexpr int kTopSide = 64;
+constexpr int kLevels = 4;
+constexpr std::array<int, kLevels> kSides = {1, kBranch, kBranch* kBranch,
+                                             kBranch* kBranch* kBranch};
+constexpr int kTopSide = kSides[kLevels - 1];
 constexpr std::int64_t kMaxCells = 16'000'000;
 
 struct LikelihoodGrid {
@@ -266,11 +268,9 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   };
   const auto by_bound = [](const Block& a, const Block& b) { return a.bound > b.bound; };
   // The top level: the coarsest whose blocks still split the window.
-  int top = kLevels - 1, top_side = kTopSide;
-  while (top > 0 && top_side / kBranch >= span) {
-    --top;
-    top_side /= kBranch;
-  }
+  int top = kLevels - 1;
+  while (top > 0 && kSides[static_cast<std::size_t>(top - 1)] >= span) --top;
+  const int top_side = kSides[static_cast<std::size_t>(top)];
   std::vector<Block> blocks;
   for (int a = -angles; a <= angles; ++a)
     for (int y = 0; y < span; y += top_side)
@@ -283,36 +283,35 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   // A pose's exact score at the finest level; kept when it beats the best so far, or ties it
   // nearer the guess.
   const auto consider = [&](const Block& leaf) {
-    if (leaf.bound < best) return false;
+    if (leaf.bound < best) return;
     const double offset = std::hypot(leaf.x - half, leaf.y - half) + std::abs(leaf.angle);
-    if (leaf.bound == best && offset >= best_offset) return false;
+    if (leaf.bound == best && offset >= best_offset) return;
     best = leaf.bound;
     best_offset = offset;
     best_a = leaf.angle;
     best_x = leaf.x;
     best_y = leaf.y;
-    return true;
   };
   // A good score early prunes most of the tree: climb from the guess (where odometry's constant
   // velocity guess and a loop's estimate usually lie close) before branching.
   {
-    int a = 0, x = half, y = half;
-    consider(bound_of(a, 0, x, y));
+    Block here = bound_of(0, 0, half, half);
+    consider(here);
     for (int step = 0; step < 32; ++step) {
-      Block up = bound_of(a, 0, x, y);
+      Block up = here;
       for (int da = -1; da <= 1; ++da)
         for (int dy = -1; dy <= 1; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
-            const int na = a + da, nx = x + dx, ny = y + dy;
-            if (std::abs(na) > angles || nx < 0 || ny < 0 || nx >= span || ny >= span) continue;
-            const Block b = bound_of(na, 0, nx, ny);
+            const int a = here.angle + da, x = here.x + dx, y = here.y + dy;
+            if ((da == 0 && dx == 0 && dy == 0) || std::abs(a) > angles || x < 0 || y < 0 ||
+                x >= span || y >= span)
+              continue;
+            const Block b = bound_of(a, 0, x, y);
             consider(b);
             if (b.bound > up.bound) up = b;
           }
-      if (up.angle == a && up.x == x && up.y == y) break;
-      a = up.angle;
-      x = up.x;
-      y = up.y;
+      if (up.bound == here.bound) break;  // no neighbour scores higher
+      here = up;
     }
   }
   const auto descend = [&](const auto& self, const Block& block) -> void {
@@ -320,8 +319,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
       consider(block);
       return;
     }
-    int side = 1;
-    for (int k = 1; k < block.level; ++k) side *= kBranch;
+    const int side = kSides[static_cast<std::size_t>(block.level - 1)];
     std::array<Block, kBranch * kBranch> next;
     std::size_t count = 0;
     for (int dy = 0; dy < kBranch; ++dy)
