@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "scanmatch/core/error.hpp"
@@ -256,6 +257,34 @@ TEST(LoopClosure2D, CliWritesTheLoopClosedRun) {
   EXPECT_TRUE(summary.contains("ate") && summary.contains("ate_odometry"));
   const auto config = nlohmann::json::parse(std::ifstream(dir.file("run/config.json")));
   EXPECT_TRUE(config.at("loop_closure").get<bool>());
+  EXPECT_TRUE(summary["loop_closure"]["thread"].get<bool>());
+}
+
+TEST(LoopClosure2D, OnItsOwnThreadItClosesTheSameLoopsAsInline) {
+  // Loop closure sees the same scans in the same order either way: the same loops and poses.
+  scanmatch::testing::TempDir dir;
+  const std::string common =
+      "map2d sim:room-2d --scans 600 --method pl-icp --no-motion-distortion --loop-closure "
+      "--quiet ";
+  const auto threaded = scanmatch::testing::run_cli(common + "--out " + dir.file("thread"));
+  ASSERT_EQ(threaded.status, 0) << threaded.output;
+  const auto inline_run =
+      scanmatch::testing::run_cli(common + "--no-loop-closure-thread --out " + dir.file("inline"));
+  ASSERT_EQ(inline_run.status, 0) << inline_run.output;
+  const auto text = [&](const std::string& name) {
+    std::ifstream in(dir.file(name));
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const auto loops = nlohmann::json::parse(text("thread/loops.json"));
+  EXPECT_GE(loops.size(), 10u);
+  EXPECT_EQ(text("thread/loops.json"), text("inline/loops.json"));
+  EXPECT_EQ(text("thread/poses_optimized_tum.txt"), text("inline/poses_optimized_tum.txt"));
+  const auto summary = [&](const std::string& name) {
+    return nlohmann::json::parse(text(name + "/summary.json"));
+  };
+  EXPECT_TRUE(summary("thread")["loop_closure"]["thread"].get<bool>());
+  EXPECT_FALSE(summary("inline")["loop_closure"]["thread"].get<bool>());
+  EXPECT_GT(summary("thread")["wall_ms_per_scan"].get<double>(), 0.0);
 }
 
 TEST(LoopClosure2D, CarmenLogStartIfPresent) {

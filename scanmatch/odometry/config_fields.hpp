@@ -431,6 +431,8 @@ void describe(Map2DRunOptions& o, Visitor& v) {
     "Also build map_reference.* from the input's reference poses");
   v("loop_closure", o.loop_closure, "--loop-closure",
     "2D loop closure: a pose graph over keyframes, verified loops, map.* from optimized poses");
+  v("loop_closure_thread", o.loop_closure_thread, "--no-loop-closure-thread",
+    "Run loop closure inline, not on its own thread (same results)");
   v.nested("loop", o.loop);
   v.nested("mapper", o.mapper);
   v.nested("grid", o.grid);

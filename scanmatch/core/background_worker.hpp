@@ -1,0 +1,119 @@
+#pragma once
+// Work done on one background thread, item by item in the order pushed, while the caller goes on:
+// loop closure beside the odometry. One thread and one order, so the results are those of doing
+// the work inline, whatever the timing.
+
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+namespace scanmatch {
+
+template <typename Item>
+class BackgroundWorker {
+ public:
+  /// `work` runs on the worker thread for each pushed item. push() waits while `capacity` items
+  /// are queued (0: never), so a worker slower than the caller holds it back instead of queueing
+  /// the whole input. With `background` false the work runs inside push() (no thread).
+  explicit BackgroundWorker(std::function<void(Item&)> work, std::size_t capacity = 0,
+                            bool background = true)
+      : work_(std::move(work)), capacity_(capacity), background_(background) {
+    if (background_) thread_ = std::thread([this] { run(); });
+  }
+  /// Drops what is still queued and joins (an exception is unwinding the caller).
+  ~BackgroundWorker() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.clear();
+      closing_ = true;
+    }
+    ready_.notify_all();
+    space_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  BackgroundWorker(const BackgroundWorker&) = delete;
+  BackgroundWorker& operator=(const BackgroundWorker&) = delete;
+
+  /// Queues an item; rethrows an exception the work threw on an earlier item.
+  void push(Item item) {
+    if (!background_) {
+      work_(item);
+      return;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    std::unique_lock<std::mutex> lock(mutex_);
+    space_.wait(lock, [&] { return error_ || capacity_ == 0 || queue_.size() < capacity_; });
+    waited_ms_ += elapsed_ms(start);
+    if (error_) std::rethrow_exception(error_);
+    queue_.push_back(std::move(item));
+    lock.unlock();
+    ready_.notify_one();
+  }
+
+  /// Waits until every queued item is done and ends the thread; rethrows the work's exception.
+  /// Call once, after the last push().
+  void finish() {
+    if (!background_) return;
+    const auto start = std::chrono::steady_clock::now();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closing_ = true;
+    }
+    ready_.notify_all();
+    if (thread_.joinable()) thread_.join();
+    waited_ms_ += elapsed_ms(start);
+    if (error_) std::rethrow_exception(error_);
+  }
+
+  /// Time push() and finish() spent waiting for the worker, ms: what the work added to the
+  /// caller's time.
+  double waited_ms() const { return waited_ms_; }
+
+ private:
+  static double elapsed_ms(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+        .count();
+  }
+
+  void run() {
+    for (;;) {
+      Item item;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        ready_.wait(lock, [&] { return closing_ || !queue_.empty(); });
+        if (queue_.empty()) return;  // closing and drained
+        item = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      space_.notify_one();
+      try {
+        work_(item);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        error_ = std::current_exception();
+        queue_.clear();
+        space_.notify_all();
+        return;
+      }
+    }
+  }
+
+  std::function<void(Item&)> work_;
+  std::size_t capacity_;
+  bool background_;
+  std::mutex mutex_;
+  std::condition_variable ready_, space_;
+  std::deque<Item> queue_;
+  bool closing_ = false;
+  std::exception_ptr error_;
+  double waited_ms_ = 0.0;
+  std::thread thread_;
+};
+
+}  // namespace scanmatch

@@ -1,0 +1,93 @@
+// BackgroundWorker (core/background_worker.hpp): items are worked in the order pushed, on one
+// thread, a full queue holds the caller back, and the work's exception reaches the caller.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "scanmatch/core/background_worker.hpp"
+
+namespace scanmatch {
+namespace {
+
+TEST(BackgroundWorker, WorksEveryItemInOrderOnOneOtherThread) {
+  for (const bool background : {true, false}) {
+    std::vector<int> seen;
+    std::vector<std::thread::id> threads;
+    BackgroundWorker<int> worker(
+        [&](int& i) {
+          seen.push_back(i);
+          threads.push_back(std::this_thread::get_id());
+        },
+        4, background);
+    for (int i = 0; i < 1000; ++i) worker.push(i);
+    worker.finish();
+    ASSERT_EQ(seen.size(), 1000u) << background;
+    for (int i = 0; i < 1000; ++i) EXPECT_EQ(seen[static_cast<std::size_t>(i)], i);
+    for (const std::thread::id& id : threads) {
+      EXPECT_EQ(id, threads.front());
+      EXPECT_EQ(id == std::this_thread::get_id(), !background);
+    }
+  }
+}
+
+TEST(BackgroundWorker, AFullQueueHoldsTheCallerBack) {
+  std::atomic<bool> release{false};
+  std::atomic<int> done{0};
+  BackgroundWorker<int> worker(
+      [&](int&) {
+        while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        ++done;
+      },
+      2);
+  // One item in the work, two queued: the fourth push waits until the work goes on.
+  for (int i = 0; i < 3; ++i) worker.push(i);
+  std::atomic<bool> pushed{false};
+  std::thread caller([&] {
+    worker.push(3);
+    pushed = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(pushed.load());
+  EXPECT_EQ(done.load(), 0);
+  release = true;
+  caller.join();
+  worker.finish();
+  EXPECT_TRUE(pushed.load());
+  EXPECT_EQ(done.load(), 4);
+  EXPECT_GT(worker.waited_ms(), 0.0);
+}
+
+TEST(BackgroundWorker, TheWorksExceptionReachesTheCaller) {
+  BackgroundWorker<int> worker([](int& i) {
+    if (i == 5) throw std::runtime_error("item 5 is bad");
+  });
+  bool thrown = false;
+  try {
+    for (int i = 0; i < 100000 && !thrown; ++i) worker.push(i);
+    worker.finish();
+  } catch (const std::runtime_error& e) {
+    thrown = true;
+    EXPECT_STREQ(e.what(), "item 5 is bad");
+  }
+  EXPECT_TRUE(thrown);
+}
+
+TEST(BackgroundWorker, DestroyedUnfinishedItDropsTheQueueAndJoins) {
+  std::atomic<int> done{0};
+  {
+    BackgroundWorker<int> worker([&](int&) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      ++done;
+    });
+    for (int i = 0; i < 1000; ++i) worker.push(i);
+  }  // as when an exception unwinds the caller: no finish()
+  EXPECT_LT(done.load(), 1000);
+}
+
+}  // namespace
+}  // namespace scanmatch
