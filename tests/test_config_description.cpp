@@ -56,8 +56,9 @@ TEST(ConfigDescription, RunAndRegisterOptionsAreDescribedOnce) {
   const auto run = flags_of<OdometryRunConfig>();
   const std::set<std::string> run_flags(run.begin(), run.end());
   EXPECT_EQ(run_flags.size(), run.size());
-  for (const char* flag : {"--no-fine", "--no-map-update", "--no-deskew", "--save-map",
-                           "--map-format", "--map-export-voxel", "--map-export-radius"})
+  for (const char* flag :
+       {"--no-fine", "--no-map-update", "--no-deskew", "--save-map", "--map-format",
+        "--map-export-voxel", "--map-export-radius", "--loop-closure", "--no-loop-closure-thread"})
     EXPECT_TRUE(run_flags.count(flag)) << flag;
   const auto pair = flags_of<PairRegistrationOptions>();
   const std::set<std::string> pair_flags(pair.begin(), pair.end());
@@ -76,6 +77,8 @@ TEST(ConfigDescription, RunOptionsAndAblationsRoundTripThroughConfigJson) {
   changed.output.map_format = "ply";
   changed.output.map_voxel_size = 0.35;
   changed.output.map_export_radius = 42.0;
+  changed.output.loop_closure = true;
+  changed.output.loop_closure_thread = false;
   changed.output.out_dir = "not/configuration";  // per invocation: not written
   const std::string text = odometry_run_config_to_json(changed);
   EXPECT_EQ(text.find("not/configuration"), std::string::npos) << text;
@@ -89,6 +92,8 @@ TEST(ConfigDescription, RunOptionsAndAblationsRoundTripThroughConfigJson) {
   EXPECT_EQ(back.output.map_format, "ply");
   EXPECT_DOUBLE_EQ(back.output.map_voxel_size, 0.35);
   EXPECT_DOUBLE_EQ(back.output.map_export_radius, 42.0);
+  EXPECT_TRUE(back.output.loop_closure);
+  EXPECT_FALSE(back.output.loop_closure_thread);
   EXPECT_TRUE(back.output.out_dir.empty());
   EXPECT_EQ(odometry_run_config_to_json(back), text);
   // The pipeline's part alone reads the same file.

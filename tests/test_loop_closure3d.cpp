@@ -1,18 +1,23 @@
 // 3D loop closure (mapping/loop_closure3d.hpp): on a simulated loop around the campus block it
 // must reduce the error against the simulator's truth, verification must reject a wrong candidate,
 // a street of identical buildings must not produce a wrong edge, bad input must be rejected, and
-// `odometry --loop-closure` must write its files.
+// `odometry --loop-closure` must write its files, the same on loop closure's own thread as inline.
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/mapping/loop_closure3d.hpp"
 #include "scanmatch/odometry/run.hpp"
@@ -256,19 +261,28 @@ Trajectory short_campus_loop() {
   return t;
 }
 
-TEST(LoopClosure3D, RunOdometryWritesTheLoopClosedRun) {
-  scanmatch::testing::TempDir dir;
+std::unique_ptr<SequenceSource> short_campus_loop_sequence() {
   sim::SimOptions simulation;
   simulation.preset = "dynamic-outdoor-fast";
   simulation.trajectory = short_campus_loop();
   simulation.frames = 100000;  // the whole trajectory
-  const auto source = sim::simulated_sequence(simulation);
-  RunOptions run;
-  run.out_dir = dir.file("run");
+  return sim::simulated_sequence(simulation);
+}
+
+// `run` with loop closure and the map, into `out_dir`.
+RunSummary run_with_loop_closure(SequenceSource& source, const std::string& out_dir,
+                                 RunOptions run = {}) {
+  run.out_dir = out_dir;
   run.write_map = true;
   run.loop_closure = true;
   run.quiet = true;
-  const RunSummary summary = run_odometry(*source, OdometryConfig{}, run);
+  return run_odometry(source, OdometryConfig{}, run);
+}
+
+TEST(LoopClosure3D, RunOdometryWritesTheLoopClosedRun) {
+  scanmatch::testing::TempDir dir;
+  const auto source = short_campus_loop_sequence();
+  const RunSummary summary = run_with_loop_closure(*source, dir.file("run"));
   for (const char* name :
        {"poses.txt", "poses_tum.txt", "poses_optimized.txt", "poses_optimized_tum.txt",
         "loops.json", "summary.json", "config.json", "map.pcd", "map_odometry.pcd"})
@@ -302,6 +316,80 @@ TEST(LoopClosure3D, RunOdometryWritesTheLoopClosedRun) {
             summary_json["ate_odometry"]["rmse_m"].get<double>() * 1.05);
   const auto config = nlohmann::json::parse(std::ifstream(dir.file("run/config.json")));
   EXPECT_TRUE(config.at("loop_closure").get<bool>());
+  EXPECT_TRUE(config.at("loop_closure_thread").get<bool>());
+  EXPECT_TRUE(summary_json["loop_closure"]["thread"].get<bool>());
+  EXPECT_GT(summary_json["wall_ms_per_frame"].get<double>(), 0.0);
+}
+
+// Loop closure sees the same frames in the same order on its thread as inline: the same loops,
+// poses and map, byte for byte.
+void expect_same_loop_closed_runs(const std::string& a, const std::string& b) {
+  for (const char* name : {"loops.json", "poses_optimized.txt", "poses_optimized_tum.txt",
+                           "map.pcd", "map_odometry.pcd", "poses.txt"})
+    EXPECT_EQ(read_file_bytes(a + "/" + name), read_file_bytes(b + "/" + name)) << name;
+}
+
+TEST(LoopClosure3D, OnItsOwnThreadItClosesTheSameLoopsAsInline) {
+  scanmatch::testing::TempDir dir;
+  const auto threaded_source = short_campus_loop_sequence();
+  const RunSummary threaded = run_with_loop_closure(*threaded_source, dir.file("thread"));
+  const auto inline_source = short_campus_loop_sequence();
+  RunOptions inline_options;
+  inline_options.loop_closure_thread = false;
+  const RunSummary inline_run =
+      run_with_loop_closure(*inline_source, dir.file("inline"), inline_options);
+  EXPECT_GT(threaded.accepted_loops, 0u);  // so that the comparison means something
+  EXPECT_EQ(threaded.accepted_loops, inline_run.accepted_loops);
+  ASSERT_EQ(threaded.optimized_poses.size(), inline_run.optimized_poses.size());
+  for (std::size_t i = 0; i < threaded.optimized_poses.size(); ++i)
+    EXPECT_EQ(threaded.optimized_poses[i].matrix(), inline_run.optimized_poses[i].matrix()) << i;
+  expect_same_loop_closed_runs(dir.file("thread"), dir.file("inline"));
+  EXPECT_TRUE(threaded.loop_closure_thread);
+  EXPECT_FALSE(inline_run.loop_closure_thread);
+  const auto summary = [&](const std::string& name) {
+    return nlohmann::json::parse(std::ifstream(dir.file(name + "/summary.json")));
+  };
+  EXPECT_TRUE(summary("thread")["loop_closure"]["thread"].get<bool>());
+  EXPECT_FALSE(summary("inline")["loop_closure"]["thread"].get<bool>());
+  EXPECT_EQ(summary("inline")["loop_closure"]["wait_ms_per_frame"].get<double>(), 0.0);
+}
+
+// Delivers a source's frames and raises `stop` after the `after`-th, as Ctrl-C would mid-run.
+class StoppingSource : public SequenceSource {
+ public:
+  StoppingSource(std::unique_ptr<SequenceSource> source, std::size_t after, std::atomic<bool>& stop)
+      : source_(std::move(source)), after_(after), stop_(stop) {}
+  std::size_t size() const override { return source_->size(); }
+  bool next(Frame& frame) override {
+    if (!source_->next(frame)) return false;
+    if (++delivered_ == after_) stop_ = true;
+    return true;
+  }
+  std::optional<Trajectory> ground_truth() const override { return source_->ground_truth(); }
+  std::string describe() const override { return source_->describe(); }
+
+ private:
+  std::unique_ptr<SequenceSource> source_;
+  std::size_t after_, delivered_ = 0;
+  std::atomic<bool>& stop_;
+};
+
+TEST(LoopClosure3D, AnInterruptedRunStillWorksTheFramesQueuedForLoopClosure) {
+  scanmatch::testing::TempDir dir;
+  constexpr std::size_t kFrames = 60;
+  for (const bool thread : {true, false}) {
+    std::atomic<bool> stop{false};
+    StoppingSource source(short_campus_loop_sequence(), kFrames, stop);
+    RunOptions run;
+    run.loop_closure_thread = thread;
+    run.stop = &stop;
+    const RunSummary summary =
+        run_with_loop_closure(source, dir.file(thread ? "thread" : "inline"), run);
+    EXPECT_TRUE(summary.interrupted);
+    EXPECT_EQ(summary.frames, kFrames);
+    EXPECT_EQ(summary.optimized_poses.size(), kFrames) << thread;
+  }
+  expect_same_loop_closed_runs(dir.file("thread"), dir.file("inline"));
 }
 
 }  // namespace

@@ -185,6 +185,8 @@ void describe(OdometryRunConfig& c, Visitor& v) {
   v("loop_closure", c.output.loop_closure, "--loop-closure",
     "3D loop closure: a pose graph over keyframes, verified loops, poses_optimized*.txt, "
     "loops.json, map.* from the optimized poses");
+  v("loop_closure_thread", c.output.loop_closure_thread, "--no-loop-closure-thread",
+    "Run loop closure inline, not on its own thread (same results)");
   v.nested("map_export", c.output);
   v.nested("loop", c.output.loop);
 }

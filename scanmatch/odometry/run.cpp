@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "scanmatch/core/background_worker.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/eval/metrics_json.hpp"
@@ -23,6 +25,11 @@
 
 namespace scanmatch {
 namespace {
+
+// Frames queued for the loop closure thread before the odometry waits for it: a 3D frame holds
+// thousands of points, so a short queue bounds the memory and holds a slower loop closure's
+// backlog to a few frames.
+constexpr std::size_t kLoopQueueFrames = 16;
 
 // The exported map: one point per cell of `voxel` metres, first come first kept, optionally only
 // near the sensor. Bounded by the area the run covered, not by the number of frames.
@@ -215,9 +222,26 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       options.max_frames > 0 ? std::min(options.max_frames, source.size()) : source.size();
   PointMap map(options.map_voxel_size);
   summary.loop_closure = options.loop_closure;
+  summary.loop_closure_thread = options.loop_closure && options.loop_closure_thread;
   std::optional<LoopClosure3D> loop_closure;
   if (options.loop_closure) loop_closure.emplace(options.loop);
   KeyframeClouds keyframe_clouds(options.map_voxel_size);
+  struct LoopInput {
+    PointCloud points;  ///< the registered frame's positions (loop closure uses no other field)
+    Pose registered = Pose::Identity();
+    bool to_map = false;  ///< the points also go into keyframe_clouds
+  };
+  // Fed in frame order; it owns `loop_closure` and `keyframe_clouds` until finish().
+  BackgroundWorker<LoopInput> loop_worker(
+      [&](LoopInput& in) {
+        loop_closure->add_frame(in.points, in.registered);
+        if (in.to_map) {
+          const std::size_t index = loop_closure->frames() - 1;
+          keyframe_clouds.add(loop_closure->keyframe_of(index), in.points,
+                              loop_closure->offset_in_keyframe(index));
+        }
+      },
+      kLoopQueueFrames, options.loop_closure && options.loop_closure_thread);
   // Per frame, its reported pose in the frame of the pose its points were registered at (the
   // pipeline reports the frame start, registers at mid-frame): the loop-closed reported pose is
   // the loop-closed registration pose followed by it.
@@ -225,6 +249,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   ProgressReporter progress("odometry " + config.method, total, "frames", options.quiet);
   Frame frame;
   double pipeline_ms = 0.0;
+  const auto run_start = std::chrono::steady_clock::now();
   while (summary.frames < total) {
     if (options.stop && options.stop->load()) {
       summary.interrupted = true;
@@ -262,14 +287,13 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                       : nullptr;
     if (loop_closure) {
       // A bridged frame (or a method that keeps no points) adds its pose only.
-      const Pose registered = map_frame != nullptr ? world_from_frame : pose;
-      loop_closure->add_frame(map_frame != nullptr ? *map_frame : PointCloud{}, registered);
-      reported_from_registered.push_back(registered.inverse() * pose);
-      if (map_frame != nullptr && options.write_map) {
-        const std::size_t index = loop_closure->frames() - 1;
-        keyframe_clouds.add(loop_closure->keyframe_of(index), *map_frame,
-                            loop_closure->offset_in_keyframe(index));
-      }
+      LoopInput in;
+      in.registered = map_frame != nullptr ? world_from_frame : pose;
+      // A copy: *map_frame is the odometry's and changes with the next frame.
+      if (map_frame != nullptr) in.points.points = map_frame->points;
+      in.to_map = map_frame != nullptr && options.write_map;
+      reported_from_registered.push_back(in.registered.inverse() * pose);
+      loop_worker.push(std::move(in));
     }
     if (map_frame != nullptr && options.write_map) {
       map.add(*map_frame, world_from_frame);
@@ -280,18 +304,29 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     progress.update(summary.frames);
   }
   progress.finish();
+  if (loop_closure) {
+    loop_worker.finish();  // also after an interruption: the queued frames are worked
+    loop_closure->finish();
+  }
+  if (summary.frames > 0)
+    summary.wall_ms_per_frame =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start)
+            .count() /
+        static_cast<double>(summary.frames);
   summary.stages = stage_statistics(summary.stats);
   summary.frames_per_second = pipeline_ms > 0.0 ? 1000.0 * summary.frames / pipeline_ms : 0.0;
   evaluate(truth, summary);
   if (loop_closure) {
-    loop_closure->finish();
     summary.loops = loop_closure->counts();
     for (std::size_t i = 0; i < loop_closure->frames(); ++i)
       summary.optimized_poses.push_back(
           orthonormalized(loop_closure->pose(i) * reported_from_registered[i]));
     for (const Loop3D& l : loop_closure->loops()) summary.accepted_loops += !l.outlier;
-    if (summary.frames > 0)
+    if (summary.frames > 0) {
       summary.loop_ms_per_frame = summary.loops.total_ms / static_cast<double>(summary.frames);
+      summary.loop_wait_ms_per_frame =
+          loop_worker.waited_ms() / static_cast<double>(summary.frames);
+    }
     if (!summary.ground_truth.empty())
       summary.ate_optimized = compute_ate(
           summary.ground_truth,
@@ -334,6 +369,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                 {"interrupted", summary.interrupted},
                                 {"error", summary.error},
                                 {"frames_per_second", summary.frames_per_second},
+                                {"wall_ms_per_frame", summary.wall_ms_per_frame},
                                 {"threads", config.threads},
                                 {"stages", stages_json(summary.stages)},
                                 {"health", health_json(summary.stats)}};
@@ -353,7 +389,9 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                            {"accepted", summary.accepted_loops},
                            {"optimizations", c.optimizations},
                            {"total_ms", c.total_ms},
-                           {"ms_per_frame", summary.loop_ms_per_frame}};
+                           {"ms_per_frame", summary.loop_ms_per_frame},
+                           {"thread", summary.loop_closure_thread},
+                           {"wait_ms_per_frame", summary.loop_wait_ms_per_frame}};
     }
     j["options"] = nlohmann::ordered_json::parse(odometry_config_to_json(config));
     write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");

@@ -9,9 +9,10 @@
 //                   points_in,points_downsampled,iterations,condition_number,
 //                   degenerate_directions,bridged
 //   summary.json    method, options (the whole configuration), frames, mean and max ms of each
-//                   stage of frame_stats.hpp, frames per second, whether the run was interrupted,
-//                   the error that ended it early, and the ATE when the source has ground truth
-//                   (written atomically at the end, also after such an error)
+//                   stage of frame_stats.hpp, frames per second, the run's wall ms per frame,
+//                   whether the run was interrupted, the error that ended it early, and the ATE
+//                   when the source has ground truth (written atomically at the end, also after
+//                   such an error)
 //   config.json     the OdometryConfig used and the map export options (reloadable with
 //                   --config; scanmatch/odometry/config_io.hpp)
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
@@ -21,10 +22,12 @@
 //                   frames' poses as poses.txt gives them, overlap, error
 //   map.pcd/.ply    on request, rebuilt from the loop-closed poses; the odometry's map becomes
 //                   map_odometry.pcd/.ply
-//   summary.json    gains "loop_closure" (counts, ms per frame), "ate" becomes the loop-closed
-//                   poses' and "ate_odometry" the odometry's
+//   summary.json    gains "loop_closure" (counts, ms per frame, whether it ran on its own
+//                   thread and how long the odometry waited for it), "ate" becomes the
+//                   loop-closed poses' and "ate_odometry" the odometry's
 // Per-frame files are appended and flushed frame by frame, so an interrupted run keeps its frames.
-// Timing covers the pipeline only (register_frame), never reading or simulating the frames.
+// Timing covers the pipeline only (register_frame), never reading or simulating the frames; only
+// wall_ms_per_frame is the whole run's.
 
 #include <atomic>
 #include <cstddef>
@@ -51,7 +54,11 @@ struct RunOptions {
   /// registered frame; writes the loop-closed poses, loops.json and the map from them.
   bool loop_closure = false;
   LoopClosure3DOptions loop;  ///< its settings (config.json's "loop")
-  bool quiet = false;         ///< no progress line
+  /// Loop closure runs on its own thread beside the odometry (which never needs its result), fed
+  /// in frame order: the same poses, loops and map as inline, and the odometry does not wait for
+  /// it where a second core is free.
+  bool loop_closure_thread = true;
+  bool quiet = false;  ///< no progress line
   /// Set to true (e.g. from a SIGINT handler) to stop after the current frame; the run then
   /// finishes its files and reports interrupted = true.
   const std::atomic<bool>* stop = nullptr;
@@ -66,6 +73,10 @@ struct RunSummary {
   /// Every stage of frame_stats.hpp, in its order (zeros before a run).
   std::vector<StageStatistics> stages = stage_statistics({});
   double frames_per_second = 0.0;  ///< 1000 / mean total ms (pipeline time only)
+  /// The run's wall time per frame from the first frame until loop closure (if any) has caught up
+  /// and finished, reading the frames included, writing the map not: what loop closure adds shows
+  /// as the difference to the same run without it.
+  double wall_ms_per_frame = 0.0;
   std::vector<double> timestamps;  ///< per frame
   std::vector<Pose> poses;         ///< per frame, world frame of frame 0
   std::vector<FrameStats> stats;   ///< per frame
@@ -75,13 +86,15 @@ struct RunSummary {
   /// does); absent without ground truth or frames.
   std::optional<AteResult> ate;
   /// With loop closure: its counts, the loop-closed poses per frame, their ATE (like `ate`), the
-  /// accepted loops (not judged outliers at the end) and the wall time it added per frame.
-  bool loop_closure = false;
+  /// accepted loops (not judged outliers at the end) and its time per frame.
+  bool loop_closure = false, loop_closure_thread = false;
   LoopClosure3DCounts loops;
   std::vector<Pose> optimized_poses;
   std::optional<AteResult> ate_optimized;
   std::size_t accepted_loops = 0;
-  double loop_ms_per_frame = 0.0;
+  double loop_ms_per_frame = 0.0;  ///< loop closure's own time per frame (on its thread or inline)
+  /// Per frame, the time the odometry waited for the loop closure thread (a full queue, the end).
+  double loop_wait_ms_per_frame = 0.0;
 
   /// The stage named `name` in frame_stats.hpp ("total"); throws std::out_of_range for others.
   const StageStatistics& stage(std::string_view name) const;
