@@ -126,11 +126,13 @@ void add_map2d_command(CLI::App& app) {
       if (s.loop_closure) {
         fmt::print(
             "loop closure: {} keyframes, {} candidates, {} verified, {} accepted ({} outliers), "
-            "{:.2f} ms per scan{}; the run took {:.2f} ms per scan, {:.2f} of it waiting for loop "
-            "closure\n",
+            "{:.2f} ms per scan {}; the run took {:.2f} ms per scan{}\n",
             s.loops.keyframes, s.loops.candidates, s.loops.verified, s.accepted_loops,
-            s.loops.outliers, s.loop_ms_per_scan, s.loop_closure_thread ? " on its own thread" : "",
-            s.wall_ms_per_scan, s.loop_wait_ms_per_scan);
+            s.loops.outliers, s.loop_ms_per_scan,
+            s.loop_closure_thread ? "on its own thread" : "inline", s.wall_ms_per_scan,
+            s.loop_closure_thread
+                ? fmt::format(", {:.2f} of it waiting for loop closure", s.loop_wait_ms_per_scan)
+                : std::string());
         print_ate("loop-closed", s.ate_optimized, s.all_pairs_optimized);
       }
       if (s.map_agreement >= 0)
