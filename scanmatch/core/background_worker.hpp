@@ -3,7 +3,6 @@
 // loop closure beside the odometry. One thread and one order, so the results are those of doing
 // the work inline, whatever the timing.
 
-#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
@@ -12,6 +11,8 @@
 #include <mutex>
 #include <thread>
 #include <utility>
+
+#include "scanmatch/core/stopwatch.hpp"
 
 namespace scanmatch {
 
@@ -46,10 +47,10 @@ class BackgroundWorker {
       work_(item);
       return;
     }
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch waiting;
     std::unique_lock<std::mutex> lock(mutex_);
     space_.wait(lock, [&] { return error_ || capacity_ == 0 || queue_.size() < capacity_; });
-    waited_ms_ += elapsed_ms(start);
+    waited_ms_ += waiting.ms();
     if (error_) std::rethrow_exception(error_);
     queue_.push_back(std::move(item));
     lock.unlock();
@@ -60,14 +61,14 @@ class BackgroundWorker {
   /// Call once, after the last push().
   void finish() {
     if (!background_) return;
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch waiting;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       closing_ = true;
     }
     ready_.notify_all();
     if (thread_.joinable()) thread_.join();
-    waited_ms_ += elapsed_ms(start);
+    waited_ms_ += waiting.ms();
     if (error_) std::rethrow_exception(error_);
   }
 
@@ -76,11 +77,6 @@ class BackgroundWorker {
   double waited_ms() const { return waited_ms_; }
 
  private:
-  static double elapsed_ms(std::chrono::steady_clock::time_point since) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-        .count();
-  }
-
   void run() {
     for (;;) {
       Item item;

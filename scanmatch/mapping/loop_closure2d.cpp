@@ -4,13 +4,13 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <utility>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch {
@@ -172,11 +172,6 @@ Eigen::Matrix3d diagonal_information(double sigma_xy, double sigma_theta) {
       .asDiagonal();
 }
 
-double elapsed_ms(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-      .count();
-}
-
 }  // namespace
 
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
@@ -261,7 +256,7 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
 }
 
 bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
   // A non-finite odometry pose would poison the graph: hold the last one instead.
   Pose2 odometry = odometry_pose;
   if (!odometry.matrix().allFinite())
@@ -299,7 +294,7 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
     if (index % options_.search_every == 0) close_loops(index);
   }
   graph_.add_frame(keyframes_.size() - 1, keyframes_.back().odometry.inverse() * odometry);
-  counts_.total_ms += elapsed_ms(start);
+  counts_.total_ms += stopwatch.ms();
   return new_keyframe;
 }
 
@@ -403,9 +398,9 @@ void LoopClosure2D::optimize() {
 }
 
 void LoopClosure2D::finish() {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
   if (!loops().empty()) optimize();  // also the loops that agreed with the estimate when added
-  counts_.total_ms += elapsed_ms(start);
+  counts_.total_ms += stopwatch.ms();
 }
 
 Pose2 LoopClosure2D::pose(std::size_t index) const {

@@ -2,10 +2,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <chrono>
 #include <utility>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/geometry/covariance.hpp"
 #include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
@@ -78,11 +78,6 @@ PoseGraph3D::Information diagonal_information(double sigma_translation, double s
   d.head<3>().setConstant(1.0 / (sigma_translation * sigma_translation));
   d.tail<3>().setConstant(1.0 / (sigma_rotation * sigma_rotation));
   return d.asDiagonal();
-}
-
-double elapsed_ms(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-      .count();
 }
 
 // The cloud without non-finite points, downsampled (an empty cloud when even that fails, e.g. a
@@ -168,7 +163,7 @@ LoopClosure3D::LoopClosure3D(const LoopClosure3DOptions& options)
 }
 
 bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pose) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
   // A non-finite or non-rigid odometry pose would poison the graph: hold the last one instead.
   Pose odometry = odometry_pose;
   if (!is_valid_pose(odometry.matrix(), 1e-3))
@@ -210,7 +205,7 @@ bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pos
     if (index % options_.search_every == 0 && !pausing) close_loops(index);
   }
   graph_.add_frame(keyframes_.size() - 1, keyframes_.back().odometry.inverse() * odometry);
-  counts_.total_ms += elapsed_ms(start);
+  counts_.total_ms += stopwatch.ms();
   return new_keyframe;
 }
 
@@ -341,9 +336,9 @@ void LoopClosure3D::optimize() {
 }
 
 void LoopClosure3D::finish() {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
   if (!loops().empty()) optimize();
-  counts_.total_ms += elapsed_ms(start);
+  counts_.total_ms += stopwatch.ms();
 }
 
 Pose LoopClosure3D::pose(std::size_t index) const {

@@ -1,9 +1,9 @@
 #include "scanmatch/odometry/mapper2d.hpp"
 
 #include <algorithm>
-#include <chrono>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 
@@ -90,7 +90,7 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   const Scan2D& current = deskew ? current_deskewed : input;
   const Scan2D& reference = deskew ? keyframe_deskewed : keyframe_;
   Pose2 relative = guess;
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
   try {
     Registration2DResult r = register_scans(current, reference, config_.registration, guess);
     const Registration2DOptions& o = config_.registration;
@@ -117,8 +117,7 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   } catch (const Error&) {
     stats_.bridged = true;  // too few points in one of the scans
   }
-  stats_.ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats_.ms = stopwatch.ms();
   Pose2 pose = keyframe_pose_ * relative;
   // Re-orthonormalise: chaining thousands of products slowly bends R off SO(2).
   pose = pose2(pose.translation().x(), pose.translation().y(), pose2_angle(pose));

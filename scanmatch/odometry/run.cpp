@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -11,6 +10,7 @@
 #include "scanmatch/core/background_worker.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/eval/metrics_json.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/geometry/voxel_hash.hpp"
@@ -249,7 +249,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   ProgressReporter progress("odometry " + config.method, total, "frames", options.quiet);
   Frame frame;
   double pipeline_ms = 0.0;
-  const auto run_start = std::chrono::steady_clock::now();
+  const Stopwatch run_time;
   while (summary.frames < total) {
     if (options.stop && options.stop->load()) {
       summary.interrupted = true;
@@ -309,10 +309,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     loop_closure->finish();
   }
   if (summary.frames > 0)
-    summary.wall_ms_per_frame =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start)
-            .count() /
-        static_cast<double>(summary.frames);
+    summary.wall_ms_per_frame = run_time.ms() / static_cast<double>(summary.frames);
   summary.stages = stage_statistics(summary.stats);
   summary.frames_per_second = pipeline_ms > 0.0 ? 1000.0 * summary.frames / pipeline_ms : 0.0;
   evaluate(truth, summary);

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -11,6 +10,7 @@
 #include "scanmatch/core/background_worker.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/io/bag/bag_sequence.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/line_writer.hpp"
@@ -138,7 +138,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   BackgroundWorker<LoopInput> loop_worker(
       [&](LoopInput& in) { loop_closure->add_scan(in.scan, in.pose); }, kLoopQueueScans,
       options.loop_closure && options.loop_closure_thread);
-  const auto run_start = std::chrono::steady_clock::now();
+  const Stopwatch run_time;
   // The registered scans, kept to rebuild the map from the optimized poses.
   std::vector<Scan2D> kept_scans;
   std::vector<Pose2> estimate, reference;
@@ -200,10 +200,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   }
   summary.scans = estimate.size();
   if (summary.scans > 0)
-    summary.wall_ms_per_scan =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start)
-            .count() /
-        static_cast<double>(summary.scans);
+    summary.wall_ms_per_scan = run_time.ms() / static_cast<double>(summary.scans);
   if (summary.scans > 1) {
     summary.mean_ms = total_ms / static_cast<double>(summary.scans - 1);
     summary.scans_per_second = 1000.0 / std::max(summary.mean_ms, 1e-9);
