@@ -127,6 +127,46 @@ TEST(LoopClosure2D, AMatchAlongAPlainCorridorHoldsNothingAlongIt) {
   EXPECT_GT(v.hessian(2, 2), 0.0);
 }
 
+TEST(LoopClosure2D, AStepAPlainCorridorLeavesOpenIsHeldLooselyAlongIt) {
+  // Down a corridor of plain walls the odometry reports 0.1 m for a 1 m step (it slid, as ACES's
+  // did): the scans fit anywhere along it, so the odometry edge must hold x loosely (for a loop to
+  // stretch it back) and y and the heading as firmly as ever; the scan becomes a keyframe though
+  // the odometry hardly moved. Past the corridor's end wall the step is determined again.
+  Scan2D corridor;  // both walls sampled every 5 cm from x = -20 to 20 m
+  for (double y : {-1.2, 1.2})
+    for (int i = -400; i <= 400; ++i) corridor.points.emplace_back(0.05 * i, y);
+  Scan2D ended;  // walls from x = 0 to 6 m and a wall across at x = 6 m
+  for (double y : {-1.2, 1.2})
+    for (int i = 0; i <= 120; ++i) ended.points.emplace_back(0.05 * i, y);
+  for (int i = -23; i <= 23; ++i) ended.points.emplace_back(6.0, 0.05 * i);
+  LoopClosure2DOptions options;
+  LoopClosure2D loops(options);
+  loops.add_scan(corridor, Pose2::Identity());
+  EXPECT_TRUE(loops.add_scan(corridor, pose2(0.1, 0.0, 0.0)));
+  ASSERT_EQ(loops.counts().open_odometry_edges, 1u);
+  ASSERT_EQ(loops.graph().edges().size(), 1u);
+  const Eigen::Matrix3d& open = loops.graph().edges()[0].information;
+  const double firm = 1.0 / (options.odometry_sigma_xy * options.odometry_sigma_xy);
+  EXPECT_LT(open(0, 0), 0.05 * firm);
+  EXPECT_NEAR(open(1, 1), firm, 1e-6 * firm);
+  EXPECT_NEAR(open(2, 2), 1.0 / std::pow(options.odometry_sigma_theta, 2), 1e-6);
+  // A 1 m step towards the end wall: determined, the fixed information.
+  LoopClosure2D towards_the_end(options);
+  towards_the_end.add_scan(ended, Pose2::Identity());
+  Scan2D closer = ended;  // seen from 1 m further along x
+  for (Eigen::Vector2d& p : closer.points) p.x() -= 1.0;
+  towards_the_end.add_scan(closer, pose2(1.0, 0.0, 0.0));
+  EXPECT_EQ(towards_the_end.counts().open_odometry_edges, 0u);
+  ASSERT_EQ(towards_the_end.graph().edges().size(), 1u);
+  EXPECT_NEAR(towards_the_end.graph().edges()[0].information(0, 0), firm, 1e-6 * firm);
+  // Off: every edge fixed, and a scan that hardly moved is no keyframe.
+  options.odometry_spread_window = 0.0;
+  LoopClosure2D fixed(options);
+  fixed.add_scan(corridor, Pose2::Identity());
+  EXPECT_FALSE(fixed.add_scan(corridor, pose2(0.1, 0.0, 0.0)));
+  EXPECT_EQ(fixed.counts().open_odometry_edges, 0u);
+}
+
 TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
   // Walls at y = +-1.2 m with a 0.6 m wide, 0.3 m deep door recess every 2 m on both sides, seen
   // by a 180-degree laser (1 deg beams, 30 m). A scan matched 2 m along (one door further) fits as
@@ -181,6 +221,8 @@ TEST(LoopClosure2D, OptionsOutOfRangeAreRefused) {
   refused([](LoopClosure2DOptions& o) { o.verification.max_shifted_fraction = -0.5; });
   refused([](LoopClosure2DOptions& o) { o.verification.min_search_score = 1.2; });
   refused([](LoopClosure2DOptions& o) { o.optimize_above = -0.1; });
+  refused([](LoopClosure2DOptions& o) { o.odometry_spread_margin = -0.01; });
+  refused([](LoopClosure2DOptions& o) { o.odometry_spread_window = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.verification.method = "no-such-method"; });
   EXPECT_NO_THROW(LoopClosure2D{LoopClosure2DOptions{}});
 }

@@ -3,6 +3,8 @@
 // the simulated floor plan, the CLI and the real CARMEN logs.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -332,6 +334,44 @@ TEST(Scan2D, CorrelativeMatchScoresTheFitAndGivesUpBelowItsMinimum) {
   EXPECT_TRUE(none.pose.isApprox(guess));
   EXPECT_LT(correlative_match(current, wall, guess, 1.0, 0.5).score, 0.4) << "one wall of six";
   EXPECT_THROW(correlative_match(current, reference, guess, 1.0, 0.5, 0.05, 0.0, 1.5), Error);
+}
+
+TEST(Scan2D, CorrelativeSpreadIsLongAlongACorridorAndShowsABetterPoseElsewhere) {
+  const auto largest = [](const CorrelativeSpread& s) {
+    return std::sqrt(
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s.second_moment).eigenvalues().maxCoeff());
+  };
+  // A room: only the right pose fits, so the spread about it is the grid's blur.
+  const Scan2D reference = room_scan(pose2(2.0, 1.5, 0.0));
+  const Pose2 truth = pose2(0.5, 0.3, 0.1);
+  const Scan2D current = room_scan(pose2(2.0, 1.5, 0.0) * truth);
+  const double degrees2 = 2.0 * M_PI / 180;
+  const CorrelativeSpread right =
+      correlative_spread(current, reference, truth, 1.5, degrees2, 0.1, 1.0, 0.05);
+  ASSERT_GT(right.poses, 0u);
+  EXPECT_GT(right.best_score, 0.7);
+  EXPECT_LT(largest(right), 0.15);
+  // 0.8 m off along x: the poses that fit lie 0.8 m away, and the spread about the wrong pose
+  // says so.
+  const Pose2 off = pose2(0.8, 0.0, 0.0) * truth;
+  const CorrelativeSpread wrong =
+      correlative_spread(current, reference, off, 1.5, degrees2, 0.1, 1.0, 0.05);
+  EXPECT_NEAR(std::sqrt(wrong.second_moment(0, 0)), 0.8, 0.1);
+  EXPECT_LT(std::sqrt(wrong.second_moment(1, 1)), 0.1);
+  // Plain walls at y = +-1.2 m, 40 m long: every translation along the corridor fits (all but the
+  // points shifted past the ends), none across it.
+  Scan2D corridor;  // both walls sampled every 5 cm from x = -20 to 20 m
+  for (double y : {-1.2, 1.2})
+    for (int i = -400; i <= 400; ++i) corridor.points.emplace_back(0.05 * i, y);
+  const CorrelativeSpread along =
+      correlative_spread(corridor, corridor, Pose2::Identity(), 1.5, degrees2, 0.1, 1.0, 0.05);
+  EXPECT_GT(std::sqrt(along.second_moment(0, 0)), 0.6);  // uniform over +-1.5 m: 0.87
+  EXPECT_LT(std::sqrt(along.second_moment(1, 1)), 0.1);
+  // Nothing to score: empty; out-of-range arguments: refused.
+  EXPECT_EQ(correlative_spread(Scan2D{}, reference, truth, 1.5, degrees2, 0.1, 1.0, 0.05).poses,
+            0u);
+  EXPECT_THROW(correlative_spread(current, reference, truth, 0.0, degrees2, 0.1, 1.0, 0.05), Error);
+  EXPECT_THROW(correlative_spread(current, reference, truth, 1.5, degrees2, 0.1, 1.0, -0.1), Error);
 }
 
 TEST(Scan2D, FilledSurfacesJoinAGrazingWallButNotADepthJump) {

@@ -62,6 +62,7 @@ py::dict counts_dict(const LoopClosure2DCounts& c) {
   d["rejected_by_estimate"] = c.rejected_by_estimate;
   d["outliers"] = c.outliers;
   d["optimizations"] = c.optimizations;
+  d["open_odometry_edges"] = c.open_odometry_edges;
   d["total_ms"] = c.total_ms;
   return d;
 }

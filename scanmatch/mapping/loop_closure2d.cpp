@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 
@@ -245,6 +246,11 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error("loop closure: pair distance, search window and resolution must be positive");
   if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
     throw Error("loop closure: keyframe thresholds must not be negative");
+  if (!(options.odometry_spread_window >= 0.0) || !(options.odometry_spread_margin >= 0.0) ||
+      !(options.odometry_spread_normal >= 0.0))
+    throw Error(
+        "loop closure: the odometry spread's window, margin and normal spread must not be "
+        "negative");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
   if (!(options.verification.min_search_score >= 0.0 &&
@@ -264,10 +270,18 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
                    ? Pose2::Identity()
                    : keyframes_.back().odometry * graph_.offset_in_keyframe(scans() - 1);
   bool new_keyframe = keyframes_.empty();
+  std::optional<OdometryInformation> information;
   if (!new_keyframe) {
     const Pose2 motion = keyframes_.back().odometry.inverse() * odometry;
     new_keyframe = motion.translation().norm() >= options_.keyframe_distance ||
                    std::abs(pose2_angle(motion)) >= options_.keyframe_angle;
+    // A scan whose step the scans leave open becomes a keyframe however little the odometry
+    // moved: a slid step is short, and only a node of its own lets the graph stretch it back.
+    if (new_keyframe ||
+        (options_.odometry_spread_window > 0.0 && options_.open_steps_are_keyframes)) {
+      information = odometry_information(keyframes_.back().points, scan, motion);
+      new_keyframe = new_keyframe || information->open;
+    }
   }
   if (new_keyframe) {
     Keyframe k;
@@ -283,10 +297,9 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
       const Pose2 measurement = previous.odometry.inverse() * odometry;
       k.path = previous.path + measurement.translation().norm();
       graph_.graph().add_node(graph().pose(index - 1) * measurement);
-      graph_.graph().add_edge(
-          index - 1, index, measurement,
-          diagonal_information(options_.odometry_sigma_xy, options_.odometry_sigma_theta),
-          EdgeKind::kOdometry);
+      graph_.graph().add_edge(index - 1, index, measurement, information->information,
+                              EdgeKind::kOdometry);
+      if (information->open) ++counts_.open_odometry_edges;
       keyframes_.push_back(std::move(k));
     }
     places_.add(make_place_descriptor(scan, options_.descriptor));
@@ -390,6 +403,29 @@ Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) 
   if (!options_.hessian_loop_information) return fallback;
   return shaped_loop_information<2>(hessian, options_.loop_sigma_xy, options_.loop_sigma_theta,
                                     fallback);
+}
+
+LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
+    const Scan2D& previous, const Scan2D& current, const Pose2& measurement) const {
+  const double sigma = options_.odometry_sigma_xy;
+  OdometryInformation out;
+  Eigen::Matrix3d& information = out.information;
+  information = diagonal_information(sigma, options_.odometry_sigma_theta);
+  if (!(options_.odometry_spread_window > 0.0)) return out;
+  // A small angle window: the rotation is what scans determine best; it lets each translation
+  // find its fit where the step's rotation is a little off.
+  const CorrelativeSpread spread = correlative_spread(
+      current, previous, measurement, options_.odometry_spread_window, 2.0 * M_PI / 180, 0.1,
+      Registration2DOptions{}.search_fill_gap, options_.odometry_spread_margin);
+  if (spread.poses == 0 || !spread.second_moment.allFinite()) return out;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(spread.second_moment);
+  const double normal = options_.odometry_spread_normal * options_.odometry_spread_normal;
+  const Eigen::Vector2d widened = (eigen.eigenvalues().array() - normal).max(0.0) + sigma * sigma;
+  if (widened.maxCoeff() <= sigma * sigma) return out;
+  out.open = true;
+  information.topLeftCorner<2, 2>() =
+      eigen.eigenvectors() * widened.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
+  return out;
 }
 
 void LoopClosure2D::optimize() {

@@ -102,6 +102,20 @@ struct LoopClosure2DOptions {
   /// cm and a fraction of a degree.
   double odometry_sigma_xy = 0.05;
   double odometry_sigma_theta = 0.5 * M_PI / 180;
+  /// Where the scans leave a step open, its edge holds it loosely: the translations within this
+  /// window (m) of the step, each at its best rotation, that fit the previous keyframe's scan
+  /// within `odometry_spread_margin` (a share of the points) of the best (correlative_spread);
+  /// their spread about the step beyond `odometry_spread_normal` (m) widens the edge's
+  /// translation covariance in its direction. A corridor's walls fit all along it, and on ACES
+  /// every step that slid or kept a turn's wrong translation spread 0.36 m or more, 95 % of the
+  /// right ones below 0.13 m; with a fixed sigma a loop cannot stretch such a step back and the
+  /// graph bends every other step instead. 0: the fixed sigmas alone.
+  double odometry_spread_window = 1.5;
+  double odometry_spread_margin = 0.05;
+  double odometry_spread_normal = 0.1;
+  /// A scan whose step from the last keyframe is open becomes a keyframe however little the
+  /// odometry moved (a slid step is short): only a node of its own lets the graph stretch it.
+  bool open_steps_are_keyframes = true;
   /// Loop edges likewise: a verified registration is good to a few cm.
   double loop_sigma_xy = 0.05;
   double loop_sigma_theta = 0.5 * M_PI / 180;
@@ -157,6 +171,9 @@ struct LoopClosure2DCounts {
   std::size_t rejected_by_estimate = 0;
   std::size_t outliers = 0;  ///< loop edges the graph judged outliers at its last optimize()
   std::size_t optimizations = 0;
+  /// Odometry edges widened because the scans left their step open (odometry_spread_window);
+  /// such a scan is a keyframe however little the odometry moved.
+  std::size_t open_odometry_edges = 0;
   double total_ms = 0.0;  ///< wall time spent in add_scan() and finish()
 };
 
@@ -193,6 +210,14 @@ class LoopClosure2D {
   /// A loop edge's information: the verification's Hessian scaled to loop_sigma_xy in its best
   /// direction, the rotation capped at loop_sigma_theta (or the diagonal of both sigmas).
   Eigen::Matrix3d loop_information(const Eigen::Matrix3d& hessian) const;
+  struct OdometryInformation {
+    Eigen::Matrix3d information;
+    bool open = false;  ///< widened: the scans leave the step open
+  };
+  /// The information of an odometry edge from `previous` to `current`, which the odometry put at
+  /// `measurement` (current in previous's frame).
+  OdometryInformation odometry_information(const Scan2D& previous, const Scan2D& current,
+                                           const Pose2& measurement) const;
   void optimize();
 
   LoopClosure2DOptions options_;

@@ -398,6 +398,14 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("odometry_sigma_xy", o.odometry_sigma_xy, nullptr, "Odometry edge standard deviation, m");
   v("odometry_sigma_theta", o.odometry_sigma_theta, nullptr,
     "Odometry edge standard deviation, rad");
+  v("odometry_spread_window", o.odometry_spread_window, nullptr,
+    "Odometry edges widen where translations within this window (m) fit as well (0: fixed)");
+  v("odometry_spread_margin", o.odometry_spread_margin, nullptr,
+    "... within this share of the points of the best fit");
+  v("odometry_spread_normal", o.odometry_spread_normal, nullptr,
+    "... by their spread beyond this, m");
+  v("open_steps_are_keyframes", o.open_steps_are_keyframes, nullptr,
+    "A scan whose step is open becomes a keyframe however little the odometry moved");
   v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
   v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");

@@ -144,6 +144,101 @@ std::vector<Vec2> thinned(const std::vector<Vec2>& points, double cell) {
   return out;
 }
 
+/// What a search over a window scores: the current scan thinned, the reference's likelihood grid
+/// and the thinned points' cells under each rotation. Empty `cells` when nothing can be scored.
+struct SearchSpace {
+  std::vector<Vec2> points;
+  LikelihoodGrid grid;
+  Pose2 initial = Pose2::Identity();
+  double angle_step = 0.0;
+  int angles = 0;  ///< rotations -angles..angles steps about the initial guess
+  int half = 0;    ///< translations -half..half cells about it
+  int span = 0;    ///< 2 * half + 1
+  std::vector<std::vector<std::pair<int, int>>> cells;  ///< per rotation, relative to -half
+
+  /// Sum over the points of the level's likelihood, at translation cell (x, y) (0..span-1).
+  float score(int angle, int level, int x, int y) const {
+    float sum = 0.0f;
+    for (const auto& [cx, cy] : cells[static_cast<std::size_t>(angle + angles)])
+      sum += grid.at(level, cx + x, cy + y);
+    return sum;
+  }
+  Pose2 pose(int angle, int x, int y) const {
+    const double r = grid.resolution;
+    return pose2(initial.translation().x() + (x - half) * r,
+                 initial.translation().y() + (y - half) * r,
+                 pose2_angle(initial) + angle * angle_step);
+  }
+};
+
+SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
+                         double window, double angle_window, double resolution, double fill_gap) {
+  SearchSpace space;
+  std::vector<Vec2>& points = space.points;
+  points = thinned(current.points, 2 * resolution);
+
+  // The grid covers where the current scan can land: its footprint under the initial guess,
+  // grown by the window and the rotation's sweep.
+  double max_range = 0.0;
+  std::vector<double> ranges;
+  ranges.reserve(points.size());
+  for (const Vec2& p : points) {
+    ranges.push_back(p.norm());
+    max_range = std::max(max_range, ranges.back());
+  }
+  // The angular step follows the 90th percentile of the ranges, not the farthest point: the few
+  // far returns (30 to 80 m on ACES) would otherwise set a 0.1 deg step. On the three CARMEN logs
+  // this searched 1.7x faster with the same failures (27 / 69 / 9 against 27 / 68 / 10).
+  const auto percentile = ranges.begin() + static_cast<std::ptrdiff_t>(ranges.size() * 9 / 10);
+  std::nth_element(ranges.begin(), percentile, ranges.end());
+  const double step_range = *percentile;
+  Vec2 low = initial.translation(), high = initial.translation();
+  for (const Vec2& p : points) {
+    const Vec2 q = initial * p;
+    low = low.cwiseMin(q);
+    high = high.cwiseMax(q);
+  }
+  const double margin = window + std::min(max_range, max_range * angle_window) + 4 * resolution;
+  low -= Vec2::Constant(margin);
+  high += Vec2::Constant(margin);
+  std::vector<Vec2> useful;
+  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
+    if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
+  if (useful.empty()) return space;
+  space.grid = make_grid(useful, resolution);
+  const LikelihoodGrid& g = space.grid;
+  const double r = g.resolution;
+
+  // Angular step: a point at `step_range` moves by about one cell.
+  space.angle_step = std::clamp(r / std::max(step_range, 1e-3), 0.1 * M_PI / 180, 1.0 * M_PI / 180);
+  space.angles = static_cast<int>(std::ceil(angle_window / space.angle_step));
+  space.half = static_cast<int>(std::ceil(window / r));  // translations -half..half cells
+  space.span = 2 * space.half + 1;
+  space.initial = initial;
+  const int angles = space.angles, half = space.half;
+
+  // Cells of the thinned points under each rotation, relative to the window's corner.
+  space.cells.resize(static_cast<std::size_t>(2 * angles + 1));
+  // floor() through a shift into positive numbers (a plain conversion truncates): far cheaper
+  // than std::floor, exact within 2^20 cells of the grid; farther (a wild point) is clamped, still
+  // off the grid, where a conversion would overflow.
+  constexpr double kShift = 1 << 20;
+  const auto cell = [&](double v) {
+    return static_cast<int>(std::clamp(v, -kShift, kShift) + kShift) - (1 << 20) - half;
+  };
+  const Vec2 start = (initial.translation() - g.origin) / r;
+  for (int a = -angles; a <= angles; ++a) {
+    const double theta = pose2_angle(initial) + a * space.angle_step;
+    const double c = std::cos(theta) / r, s = std::sin(theta) / r;
+    auto& out = space.cells[static_cast<std::size_t>(a + angles)];
+    out.reserve(points.size());
+    for (const Vec2& p : points)
+      out.push_back(
+          {cell(c * p.x() - s * p.y() + start.x()), cell(s * p.x() + c * p.y() + start.y())});
+  }
+  return space;
+}
+
 }  // namespace
 
 std::vector<Vec2> filled_surfaces(const Scan2D& scan, double max_gap, double step) {
@@ -192,66 +287,11 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   CorrelativeMatch match;
   match.pose = initial;
   if (current.points.empty() || reference.points.empty()) return match;
-  const std::vector<Vec2> points = thinned(current.points, 2 * resolution);
-
-  // The grid covers where the current scan can land: its footprint under the initial guess,
-  // grown by the window and the rotation's sweep.
-  double max_range = 0.0;
-  std::vector<double> ranges;
-  ranges.reserve(points.size());
-  for (const Vec2& p : points) {
-    ranges.push_back(p.norm());
-    max_range = std::max(max_range, ranges.back());
-  }
-  // The angular step follows the 90th percentile of the ranges, not the farthest point: the few
-  // far returns (30 to 80 m on ACES) would otherwise set a 0.1 deg step. On the three CARMEN logs
-  // this searched 1.7x faster with the same failures (27 / 69 / 9 against 27 / 68 / 10).
-  const auto percentile = ranges.begin() + static_cast<std::ptrdiff_t>(ranges.size() * 9 / 10);
-  std::nth_element(ranges.begin(), percentile, ranges.end());
-  const double step_range = *percentile;
-  Vec2 low = initial.translation(), high = initial.translation();
-  for (const Vec2& p : points) {
-    const Vec2 q = initial * p;
-    low = low.cwiseMin(q);
-    high = high.cwiseMax(q);
-  }
-  const double margin = window + std::min(max_range, max_range * angle_window) + 4 * resolution;
-  low -= Vec2::Constant(margin);
-  high += Vec2::Constant(margin);
-  std::vector<Vec2> useful;
-  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
-    if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
-  if (useful.empty()) return match;
-  const LikelihoodGrid g = make_grid(useful, resolution);
-  const double r = g.resolution;
-
-  // Angular step: a point at `step_range` moves by about one cell.
-  const double angle_step =
-      std::clamp(r / std::max(step_range, 1e-3), 0.1 * M_PI / 180, 1.0 * M_PI / 180);
-  const int angles = static_cast<int>(std::ceil(angle_window / angle_step));
-  const int half = static_cast<int>(std::ceil(window / r));  // translations -half..half cells
-  const double theta0 = pose2_angle(initial);
-
-  // Cells of the thinned points under each rotation, relative to the window's corner.
-  std::vector<std::vector<std::pair<int, int>>> cells(static_cast<std::size_t>(2 * angles + 1));
-  const int span = 2 * half + 1;
-  // floor() through a shift into positive numbers (a plain conversion truncates): far cheaper
-  // than std::floor, exact within 2^20 cells of the grid; farther (a wild point) is clamped, still
-  // off the grid, where a conversion would overflow.
-  constexpr double kShift = 1 << 20;
-  const auto cell = [&](double v) {
-    return static_cast<int>(std::clamp(v, -kShift, kShift) + kShift) - (1 << 20) - half;
-  };
-  const Vec2 start = (initial.translation() - g.origin) / r;
-  for (int a = -angles; a <= angles; ++a) {
-    const double theta = theta0 + a * angle_step;
-    const double c = std::cos(theta) / r, s = std::sin(theta) / r;
-    auto& out = cells[static_cast<std::size_t>(a + angles)];
-    out.reserve(points.size());
-    for (const Vec2& p : points)
-      out.push_back(
-          {cell(c * p.x() - s * p.y() + start.x()), cell(s * p.x() + c * p.y() + start.y())});
-  }
+  const SearchSpace space =
+      search_space(current, reference, initial, window, angle_window, resolution, fill_gap);
+  if (space.cells.empty()) return match;
+  const std::vector<Vec2>& points = space.points;
+  const int angles = space.angles, half = space.half, span = space.span;
   // Branch and bound, depth first: a block of translations is bounded by its level's maxima; the
   // children of the most promising blocks are looked at first, so the best score found early
   // dismisses most of the window. Exact at the finest level; ties go to the translation nearest
@@ -261,10 +301,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
     int angle, level, x, y;  ///< corner, in translation cells relative to -half
   };
   const auto bound_of = [&](int angle, int level, int x, int y) {
-    float sum = 0.0f;
-    for (const auto& [cx, cy] : cells[static_cast<std::size_t>(angle + angles)])
-      sum += g.at(level, cx + x, cy + y);
-    return Block{sum, angle, level, x, y};
+    return Block{space.score(angle, level, x, y), angle, level, x, y};
   };
   const auto by_bound = [](const Block& a, const Block& b) { return a.bound > b.bound; };
   // The top level: the coarsest whose blocks still split the window.
@@ -340,9 +377,44 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   if (!std::isfinite(best_offset)) return match;  // nothing reached the minimum score
   match.found = true;
   match.score = best / static_cast<double>(points.size());
-  match.pose = pose2(initial.translation().x() + (best_x - half) * r,
-                     initial.translation().y() + (best_y - half) * r, theta0 + best_a * angle_step);
+  match.pose = space.pose(best_a, best_x, best_y);
   return match;
+}
+
+CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
+                                     const Pose2& at, double window, double angle_window,
+                                     double resolution, double fill_gap, double margin) {
+  if (!(window > 0.0) || !(angle_window >= 0.0) || !(resolution > 0.0) || !(margin >= 0.0))
+    throw Error("correlative spread: window, resolution and margin must be positive");
+  CorrelativeSpread spread;
+  if (current.points.empty() || reference.points.empty()) return spread;
+  const SearchSpace space =
+      search_space(current, reference, at, window, angle_window, resolution, fill_gap);
+  if (space.cells.empty()) return spread;
+  // Each translation's best rotation, every cell of the window: no bound can skip the poses
+  // that nearly tie with the best, and those are what this measures.
+  std::vector<float> best_of(static_cast<std::size_t>(space.span * space.span), 0.0f);
+  float best = 0.0f;
+  for (int y = 0; y < space.span; ++y)
+    for (int x = 0; x < space.span; ++x) {
+      float& cell = best_of[static_cast<std::size_t>(y * space.span + x)];
+      for (int a = -space.angles; a <= space.angles; ++a)
+        cell = std::max(cell, space.score(a, 0, x, y));
+      best = std::max(best, cell);
+    }
+  const double points = static_cast<double>(space.points.size());
+  spread.best_score = best / points;
+  const float threshold = static_cast<float>(best - margin * points);
+  const double r = space.grid.resolution;
+  for (int y = 0; y < space.span; ++y)
+    for (int x = 0; x < space.span; ++x) {
+      if (best_of[static_cast<std::size_t>(y * space.span + x)] < threshold) continue;
+      const Eigen::Vector2d offset((x - space.half) * r, (y - space.half) * r);
+      spread.second_moment += offset * offset.transpose();
+      ++spread.poses;
+    }
+  if (spread.poses > 0) spread.second_moment /= static_cast<double>(spread.poses);
+  return spread;
 }
 
 }  // namespace scanmatch

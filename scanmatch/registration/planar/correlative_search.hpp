@@ -36,6 +36,24 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
                                    double resolution = 0.05, double fill_gap = 0.0,
                                    double min_score = 0.0);
 
+/// How much a scan's translation is left open at a pose (`at`, current in the reference's frame):
+/// the translations within +- `window` (m) of it, each at its best rotation within
+/// +- `angle_window` (rad), that score within `margin` (a share) of the window's best.
+struct CorrelativeSpread {
+  /// Of those translations' offsets from `at` (m^2): where they lie along a corridor whose walls
+  /// fit anywhere, it is long that way; a pose in a wrong basin shows the better one as an offset.
+  Eigen::Matrix2d second_moment = Eigen::Matrix2d::Zero();
+  double best_score = 0.0;  ///< the window's best, as a share of the best possible
+  std::size_t poses = 0;    ///< translations counted (0: nothing could be scored)
+};
+
+/// Scores every translation of the window (no branch and bound), so it costs a full search's
+/// worth at the finest level: keep the window small and the resolution coarse (0.1 m).
+/// Throws Error unless the window and resolution are positive and the margin is not negative.
+CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
+                                     const Pose2& at, double window, double angle_window,
+                                     double resolution, double fill_gap, double margin);
+
 /// The scan's points plus points every `step` (m) between beam neighbours up to `max_gap` apart
 /// that lie on one straight surface (a third neighbour on their line). Two scans sample a wall
 /// seen at a grazing angle at different places, metres apart; scored against the samples alone, a
