@@ -52,6 +52,10 @@ class LoopClosure2D(unittest.TestCase):
         self.assertEqual(len(closure), 500)
         self.assertEqual(closure.poses.shape, (500, 3, 3))
         self.assertEqual(closure.counts["keyframes"], keyframes)
+        # Steps along the hallway (plain walls, doors every 5 m) are left open by the scans; the
+        # rooms' are not.
+        self.assertGreater(closure.counts["open_odometry_edges"], 0)
+        self.assertLess(closure.counts["open_odometry_edges"], keyframes // 2)
         before, after = rmse(truth, odometry), rmse(truth, closure.poses)
         self.assertGreater(before, 0.3)
         self.assertLess(after, 0.5 * before)
@@ -65,6 +69,7 @@ class LoopClosure2D(unittest.TestCase):
     def test_options_and_errors(self):
         options = scanmatch.loop_closure_2d_options()
         self.assertIn("verification.min_paired_fraction", options)
+        self.assertEqual(options["odometry_spread_window"], 1.5)
         self.assertEqual(options["graph.loop_kernel"], "cauchy")
         with self.assertRaisesRegex(TypeError, "no_such_option"):
             scanmatch.LoopClosure2D(no_such_option=1)

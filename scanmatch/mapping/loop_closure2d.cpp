@@ -247,7 +247,7 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
   if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
     throw Error("loop closure: keyframe thresholds must not be negative");
   if (!(options.odometry_spread_window >= 0.0) || !(options.odometry_spread_margin >= 0.0) ||
-      !(options.odometry_spread_normal >= 0.0))
+      !(options.odometry_spread_normal >= 0.0) || !(options.open_step_spread >= 0.0))
     throw Error(
         "loop closure: the odometry spread's window, margin and normal spread must not be "
         "negative");
@@ -422,7 +422,8 @@ LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
   const double normal = options_.odometry_spread_normal * options_.odometry_spread_normal;
   const Eigen::Vector2d widened = (eigen.eigenvalues().array() - normal).max(0.0) + sigma * sigma;
   if (widened.maxCoeff() <= sigma * sigma) return out;
-  out.open = true;
+  out.open =
+      eigen.eigenvalues().maxCoeff() >= options_.open_step_spread * options_.open_step_spread;
   information.topLeftCorner<2, 2>() =
       eigen.eigenvectors() * widened.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
   return out;

@@ -113,9 +113,13 @@ struct LoopClosure2DOptions {
   double odometry_spread_window = 1.5;
   double odometry_spread_margin = 0.05;
   double odometry_spread_normal = 0.1;
-  /// A scan whose step from the last keyframe is open becomes a keyframe however little the
-  /// odometry moved (a slid step is short): only a node of its own lets the graph stretch it.
+  /// A scan whose step from the last keyframe is open, its spread at least `open_step_spread` (m),
+  /// becomes a keyframe however little the odometry moved (a slid step is short): only a node of
+  /// its own lets the graph stretch it. ACES's wrong steps spread 0.36 m and more; room-2d's
+  /// hallway, doors every 5 m, spreads right steps up to 0.3 m. A laser at tens of Hz down a plain
+  /// corridor would make nearly every scan a keyframe this way: turn it off for such data.
   bool open_steps_are_keyframes = true;
+  double open_step_spread = 0.3;
   /// Loop edges likewise: a verified registration is good to a few cm.
   double loop_sigma_xy = 0.05;
   double loop_sigma_theta = 0.5 * M_PI / 180;
@@ -171,8 +175,7 @@ struct LoopClosure2DCounts {
   std::size_t rejected_by_estimate = 0;
   std::size_t outliers = 0;  ///< loop edges the graph judged outliers at its last optimize()
   std::size_t optimizations = 0;
-  /// Odometry edges widened because the scans left their step open (odometry_spread_window);
-  /// such a scan is a keyframe however little the odometry moved.
+  /// Odometry edges whose step the scans leave open (a spread of at least open_step_spread).
   std::size_t open_odometry_edges = 0;
   double total_ms = 0.0;  ///< wall time spent in add_scan() and finish()
 };
@@ -212,7 +215,7 @@ class LoopClosure2D {
   Eigen::Matrix3d loop_information(const Eigen::Matrix3d& hessian) const;
   struct OdometryInformation {
     Eigen::Matrix3d information;
-    bool open = false;  ///< widened: the scans leave the step open
+    bool open = false;  ///< the scans leave the step open (open_step_spread)
   };
   /// The information of an odometry edge from `previous` to `current`, which the odometry put at
   /// `measurement` (current in previous's frame).

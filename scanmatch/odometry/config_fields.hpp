@@ -406,6 +406,7 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
     "... by their spread beyond this, m");
   v("open_steps_are_keyframes", o.open_steps_are_keyframes, nullptr,
     "A scan whose step is open becomes a keyframe however little the odometry moved");
+  v("open_step_spread", o.open_step_spread, nullptr, "... open: its spread is at least this, m");
   v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
   v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");

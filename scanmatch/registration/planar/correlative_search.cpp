@@ -391,20 +391,36 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
   const SearchSpace space =
       search_space(current, reference, at, window, angle_window, resolution, fill_gap);
   if (space.cells.empty()) return spread;
-  // Each translation's best rotation, every cell of the window: no bound can skip the poses
-  // that nearly tie with the best, and those are what this measures.
+  // Each translation's best rotation. Blocks of 4 x 4 translations are bounded by the grid's first
+  // max-filtered level and looked at best first; once a block's bound falls below the best found
+  // less the margin, no translation in it or in any later block can count.
+  const double points = static_cast<double>(space.points.size());
+  const float allowance = static_cast<float>(margin * points);
+  struct Block {
+    float bound;
+    int angle, x, y;
+  };
+  constexpr int kSide = kSides[1];
+  std::vector<Block> blocks;
+  for (int a = -space.angles; a <= space.angles; ++a)
+    for (int y = 0; y < space.span; y += kSide)
+      for (int x = 0; x < space.span; x += kSide)
+        blocks.push_back({space.score(a, 1, x, y), a, x, y});
+  std::sort(blocks.begin(), blocks.end(),
+            [](const Block& a, const Block& b) { return a.bound > b.bound; });
   std::vector<float> best_of(static_cast<std::size_t>(space.span * space.span), 0.0f);
   float best = 0.0f;
-  for (int y = 0; y < space.span; ++y)
-    for (int x = 0; x < space.span; ++x) {
-      float& cell = best_of[static_cast<std::size_t>(y * space.span + x)];
-      for (int a = -space.angles; a <= space.angles; ++a)
-        cell = std::max(cell, space.score(a, 0, x, y));
-      best = std::max(best, cell);
-    }
-  const double points = static_cast<double>(space.points.size());
+  for (const Block& block : blocks) {
+    if (block.bound < best - allowance) break;
+    for (int y = block.y; y < std::min(block.y + kSide, space.span); ++y)
+      for (int x = block.x; x < std::min(block.x + kSide, space.span); ++x) {
+        float& cell = best_of[static_cast<std::size_t>(y * space.span + x)];
+        cell = std::max(cell, space.score(block.angle, 0, x, y));
+        best = std::max(best, cell);
+      }
+  }
   spread.best_score = best / points;
-  const float threshold = static_cast<float>(best - margin * points);
+  const float threshold = best - allowance;
   const double r = space.grid.resolution;
   for (int y = 0; y < space.span; ++y)
     for (int x = 0; x < space.span; ++x) {

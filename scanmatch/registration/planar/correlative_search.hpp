@@ -47,8 +47,9 @@ struct CorrelativeSpread {
   std::size_t poses = 0;    ///< translations counted (0: nothing could be scored)
 };
 
-/// Scores every translation of the window (no branch and bound), so it costs a full search's
-/// worth at the finest level: keep the window small and the resolution coarse (0.1 m).
+/// Every translation that can come within the margin is scored exactly (blocks of them bounded as
+/// the search bounds them, best first), so a flat fit costs far more than a sharp one: keep the
+/// window small and the resolution coarse (0.1 m).
 /// Throws Error unless the window and resolution are positive and the margin is not negative.
 CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
                                      const Pose2& at, double window, double angle_window,
