@@ -367,6 +367,19 @@ TEST(Scan2D, CorrelativeSpreadIsLongAlongACorridorAndShowsABetterPoseElsewhere) 
       correlative_spread(corridor, corridor, Pose2::Identity(), 1.5, degrees2, 0.1, 1.0, 0.05);
   EXPECT_GT(std::sqrt(along.second_moment(0, 0)), 0.6);  // uniform over +-1.5 m: 0.87
   EXPECT_LT(std::sqrt(along.second_moment(1, 1)), 0.1);
+  // A non-finite point lands nowhere and changes nothing.
+  Scan2D with_nan = current;
+  with_nan.points.emplace_back(std::nan(""), 1.0);
+  with_nan.points.emplace_back(std::numeric_limits<double>::infinity(), 0.0);
+  const CorrelativeSpread same =
+      correlative_spread(with_nan, reference, off, 1.5, degrees2, 0.1, 1.0, 0.05);
+  EXPECT_EQ(same.poses, wrong.poses);
+  EXPECT_TRUE(same.second_moment.isApprox(wrong.second_moment));
+  Scan2D only_nan;
+  only_nan.points.emplace_back(std::nan(""), std::nan(""));
+  EXPECT_EQ(correlative_spread(only_nan, reference, truth, 1.5, degrees2, 0.1, 1.0, 0.05).poses,
+            0u);
+  EXPECT_FALSE(correlative_match(only_nan, reference, truth, 1.0, 0.5).found);
   // Nothing to score: empty; out-of-range arguments: refused.
   EXPECT_EQ(correlative_spread(Scan2D{}, reference, truth, 1.5, degrees2, 0.1, 1.0, 0.05).poses,
             0u);

@@ -249,8 +249,8 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
   if (!(options.odometry_spread_window >= 0.0) || !(options.odometry_spread_margin >= 0.0) ||
       !(options.odometry_spread_normal >= 0.0) || !(options.open_step_spread >= 0.0))
     throw Error(
-        "loop closure: the odometry spread's window, margin and normal spread must not be "
-        "negative");
+        "loop closure: the odometry spread's window, margin, normal and open spreads must not "
+        "be negative");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
   if (!(options.verification.min_search_score >= 0.0 &&

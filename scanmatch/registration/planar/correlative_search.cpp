@@ -144,6 +144,21 @@ std::vector<Vec2> thinned(const std::vector<Vec2>& points, double cell) {
   return out;
 }
 
+void check_window(double window, double angle_window, double resolution) {
+  if (!(window > 0.0) || !(angle_window >= 0.0) || !(resolution > 0.0))
+    throw Error("correlative search: window and resolution must be positive");
+}
+
+/// A block of translations (corner x, y in cells from the window's -half, side kSides[level]) at
+/// one rotation, with the upper bound of their scores at that level.
+struct Block {
+  float bound;
+  int angle, level, x, y;
+};
+bool higher_bound(const Block& a, const Block& b) {
+  return a.bound > b.bound;
+}
+
 /// What a search over a window scores: the current scan thinned, the reference's likelihood grid
 /// and the thinned points' cells under each rotation. Empty `cells` when nothing can be scored.
 struct SearchSpace {
@@ -175,7 +190,13 @@ SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const P
                          double window, double angle_window, double resolution, double fill_gap) {
   SearchSpace space;
   std::vector<Vec2>& points = space.points;
-  points = thinned(current.points, 2 * resolution);
+  // A non-finite point lands nowhere; dropped here, before any conversion to a cell.
+  std::vector<Vec2> finite;
+  finite.reserve(current.points.size());
+  for (const Vec2& p : current.points)
+    if (p.allFinite()) finite.push_back(p);
+  points = thinned(finite, 2 * resolution);
+  if (points.empty()) return space;
 
   // The grid covers where the current scan can land: its footprint under the initial guess,
   // grown by the window and the rotation's sweep.
@@ -280,8 +301,7 @@ Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const P
 CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& reference,
                                    const Pose2& initial, double window, double angle_window,
                                    double resolution, double fill_gap, double min_score) {
-  if (!(window > 0.0) || !(angle_window >= 0.0) || !(resolution > 0.0))
-    throw Error("correlative search: window and resolution must be positive");
+  check_window(window, angle_window, resolution);
   if (!(min_score >= 0.0 && min_score <= 1.0))
     throw Error("correlative search: the minimum score must be in [0, 1]");
   CorrelativeMatch match;
@@ -296,14 +316,9 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   // children of the most promising blocks are looked at first, so the best score found early
   // dismisses most of the window. Exact at the finest level; ties go to the translation nearest
   // the guess.
-  struct Block {
-    float bound;
-    int angle, level, x, y;  ///< corner, in translation cells relative to -half
-  };
   const auto bound_of = [&](int angle, int level, int x, int y) {
     return Block{space.score(angle, level, x, y), angle, level, x, y};
   };
-  const auto by_bound = [](const Block& a, const Block& b) { return a.bound > b.bound; };
   // The top level: the coarsest whose blocks still split the window.
   int top = kLevels - 1;
   while (top > 0 && kSides[static_cast<std::size_t>(top - 1)] >= span) --top;
@@ -312,7 +327,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   for (int a = -angles; a <= angles; ++a)
     for (int y = 0; y < span; y += top_side)
       for (int x = 0; x < span; x += top_side) blocks.push_back(bound_of(a, top, x, y));
-  std::sort(blocks.begin(), blocks.end(), by_bound);
+  std::sort(blocks.begin(), blocks.end(), higher_bound);
   // Below the minimum nothing counts, so the bounds prune from the start.
   float best = static_cast<float>(min_score * static_cast<double>(points.size()));
   int best_a = 0, best_x = half, best_y = half;
@@ -364,7 +379,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
         const int x = block.x + dx * side, y = block.y + dy * side;
         if (x < span && y < span) next[count++] = bound_of(block.angle, block.level - 1, x, y);
       }
-    std::sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(count), by_bound);
+    std::sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(count), higher_bound);
     for (std::size_t i = 0; i < count; ++i) {
       if (next[i].bound < best) break;
       self(self, next[i]);
@@ -384,8 +399,8 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
 CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
                                      const Pose2& at, double window, double angle_window,
                                      double resolution, double fill_gap, double margin) {
-  if (!(window > 0.0) || !(angle_window >= 0.0) || !(resolution > 0.0) || !(margin >= 0.0))
-    throw Error("correlative spread: window, resolution and margin must be positive");
+  check_window(window, angle_window, resolution);
+  if (!(margin >= 0.0)) throw Error("correlative search: the margin must not be negative");
   CorrelativeSpread spread;
   if (current.points.empty() || reference.points.empty()) return spread;
   const SearchSpace space =
@@ -396,18 +411,13 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
   // less the margin, no translation in it or in any later block can count.
   const double points = static_cast<double>(space.points.size());
   const float allowance = static_cast<float>(margin * points);
-  struct Block {
-    float bound;
-    int angle, x, y;
-  };
-  constexpr int kSide = kSides[1];
+  constexpr int kLevel = 1, kSide = kSides[kLevel];
   std::vector<Block> blocks;
   for (int a = -space.angles; a <= space.angles; ++a)
     for (int y = 0; y < space.span; y += kSide)
       for (int x = 0; x < space.span; x += kSide)
-        blocks.push_back({space.score(a, 1, x, y), a, x, y});
-  std::sort(blocks.begin(), blocks.end(),
-            [](const Block& a, const Block& b) { return a.bound > b.bound; });
+        blocks.push_back({space.score(a, kLevel, x, y), a, kLevel, x, y});
+  std::sort(blocks.begin(), blocks.end(), higher_bound);
   std::vector<float> best_of(static_cast<std::size_t>(space.span * space.span), 0.0f);
   float best = 0.0f;
   for (const Block& block : blocks) {
