@@ -103,9 +103,11 @@ void add_map2d_command(CLI::App& app) {
       s = run_map2d(input, c->out, run);
     }
     if (!c->run.quiet) {
-      fmt::print("map2d {}: {} scans, {} bridged, {:.2f} ms per scan ({:.0f} scans/s){}\n",
-                 run.mapper.registration.method, s.scans, s.bridged, s.mean_ms, s.scans_per_second,
-                 s.interrupted ? ", interrupted" : "");
+      fmt::print(
+          "map2d {}: {} scans, {} bridged, {} open steps taken from the motion prior, {:.2f} ms "
+          "per scan ({:.0f} scans/s){}\n",
+          run.mapper.registration.method, s.scans, s.bridged, s.open_steps_from_prior, s.mean_ms,
+          s.scans_per_second, s.interrupted ? ", interrupted" : "");
       for (const RelativeError2D* e : {&s.one_step, &s.ten_steps})
         if (e->pairs > 0)
           fmt::print(

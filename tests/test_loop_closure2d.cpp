@@ -21,6 +21,36 @@
 namespace scanmatch {
 namespace {
 
+struct Segment {
+  Eigen::Vector2d a, b;
+};
+
+// A 180-degree laser (1-degree beams, returns up to 30 m) at `pose` among `walls`, in its frame.
+Scan2D half_scan(const std::vector<Segment>& walls, const Pose2& pose) {
+  Scan2D scan;
+  const Eigen::Vector2d o = pose.translation();
+  for (int beam = 0; beam <= 180; ++beam) {
+    const double a = pose2_angle(pose) + (beam - 90) * M_PI / 180;
+    const Eigen::Vector2d d(std::cos(a), std::sin(a));
+    double best = 30.0;
+    for (const Segment& w : walls) {
+      Eigen::Matrix2d A;
+      A << d, w.a - w.b;
+      if (std::abs(A.determinant()) < 1e-12) continue;
+      const Eigen::Vector2d ts = A.inverse() * (w.a - o);
+      if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) best = std::min(best, ts.x());
+    }
+    if (best < 30.0) scan.points.push_back(pose.inverse() * (o + best * d));
+  }
+  return scan;
+}
+
+// An 8 x 6 m room centred on the origin with a 1 x 1 m block in one corner (not symmetric).
+std::vector<Segment> room_walls() {
+  return {{{-4, -3}, {4, -3}}, {{4, -3}, {4, 2}},   {{4, 2}, {3, 2}},     {{3, 2}, {3, 3}},
+          {{3, 3}, {-4, 3}},   {{-4, 3}, {-4, -3}}, {{-4, -1}, {-3, -1}}, {{-3, -1}, {-3, -3}}};
+}
+
 Scans2D room_scans(std::size_t count) {
   SequenceOptions o;
   o.simulator.motion_distortion = false;
@@ -90,16 +120,17 @@ TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
   const auto scan = [&](std::size_t i) { return scan_from_laser(input.scans[i], 0.05, 0.0, 0.0); };
   const auto pose = [&](std::size_t i) { return pose2(input.scans[i].pose); };
   const std::size_t current = 42, candidate = 38;  // past door recesses: not ambiguous
-  Scan2D submap = scan(candidate);
+  std::vector<Scan2D> older;
+  for (std::size_t j = candidate - 6; j < candidate; ++j) older.push_back(scan(j));
+  std::vector<PosedScan2D> neighbours;
   for (std::size_t j = candidate - 6; j < candidate; ++j)
-    for (const Eigen::Vector2d& p : scan(j).points)
-      submap.points.push_back(pose(candidate).inverse() * pose(j) * p);
+    neighbours.push_back({&older[j - (candidate - 6)], pose(candidate).inverse() * pose(j)});
   const Pose2 truth = pose(candidate).inverse() * pose(current);
   const Pose2 guess = truth * pose2(0.4, -0.3, 0.05);
   const LoopVerification2DOptions options;
   const LoopVerification2D alone = verify_loop_2d(scan(current), scan(candidate), guess, options);
   const LoopVerification2D joined =
-      verify_loop_2d(scan(current), scan(candidate), guess, options, &submap);
+      verify_loop_2d(scan(current), scan(candidate), guess, options, neighbours);
   EXPECT_FALSE(alone.accepted) << alone.paired_fraction;
   EXPECT_LT(alone.paired_fraction, options.min_paired_fraction);
   EXPECT_TRUE(joined.accepted) << joined.paired_fraction << " " << joined.error << " "
@@ -171,9 +202,6 @@ TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
   // Walls at y = +-1.2 m with a 0.6 m wide, 0.3 m deep door recess every 2 m on both sides, seen
   // by a 180-degree laser (1 deg beams, 30 m). A scan matched 2 m along (one door further) fits as
   // well as in place: without the shift test it would be accepted; with it, rejected.
-  struct Segment {
-    Eigen::Vector2d a, b;
-  };
   std::vector<Segment> walls;
   for (double x = -10.0; x < 40.0; x += 2.0)
     for (double side : {-1.0, 1.0}) {
@@ -183,23 +211,7 @@ TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
       walls.push_back({{x + 1.4, deep}, {x + 2.0, deep}});
       walls.push_back({{x + 2.0, deep}, {x + 2.0, y}});
     }
-  const auto scan_at = [&](double x0) {
-    Scan2D scan;
-    for (int beam = 0; beam <= 180; ++beam) {
-      const double a = (beam - 90) * M_PI / 180;
-      const Eigen::Vector2d d(std::cos(a), std::sin(a)), o(x0, 0.0);
-      double best = 30.0;
-      for (const Segment& w : walls) {
-        Eigen::Matrix2d A;
-        A << d, w.a - w.b;
-        if (std::abs(A.determinant()) < 1e-12) continue;
-        const Eigen::Vector2d ts = A.inverse() * (w.a - o);
-        if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) best = std::min(best, ts.x());
-      }
-      if (best < 30.0) scan.points.push_back(best * d);
-    }
-    return scan;
-  };
+  const auto scan_at = [&](double x0) { return half_scan(walls, pose2(x0, 0.0, 0.0)); };
   const Scan2D here = scan_at(0.3), later = scan_at(2.3);  // one door further along
   LoopVerification2DOptions options;
   const LoopVerification2D checked = verify_loop_2d(later, here, pose2(0.1, 0.0, 0.0), options);
@@ -208,6 +220,45 @@ TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
   EXPECT_TRUE(unchecked.accepted) << unchecked.paired_fraction << " " << unchecked.constraint;
   EXPECT_FALSE(checked.accepted);
   EXPECT_GT(checked.shifted_fraction, 0.8);
+}
+
+TEST(LoopClosure2D, FreeSpaceIsSeenBetweenOneDegreeBeams) {
+  // The candidate saw a 1 m box at x = 2.5 m (an object moved away since, or another place) where
+  // the current scan, 1 m further along, sees the far wall: a tenth of the candidate's points lie
+  // in the current scan's free space. With bearings binned finer than the beams this went unseen
+  // (every other bin empty).
+  std::vector<Segment> with_box = room_walls();
+  with_box.push_back({{2.5, -0.5}, {2.5, 0.5}});
+  const Pose2 truth = pose2(1.0, 0.2, 0.05);
+  const Scan2D current = half_scan(room_walls(), truth);
+  const LoopVerification2DOptions options;
+  const LoopVerification2D same =
+      verify_loop_2d(current, half_scan(room_walls(), Pose2::Identity()), truth, options);
+  EXPECT_TRUE(same.accepted) << same.paired_fraction << " " << same.free_violations;
+  EXPECT_LT(same.free_violations, 0.01);
+  const LoopVerification2D moved =
+      verify_loop_2d(current, half_scan(with_box, Pose2::Identity()), truth, options);
+  EXPECT_FALSE(moved.accepted);
+  EXPECT_GT(moved.free_violations, 0.08);
+  // Joined scans: each saw free space from its own pose. The candidate faces away (it sees x < 0)
+  // and a neighbour taken at its side sees the room without the box: the box in the current scan
+  // lies in the neighbour's free space, though not in the candidate's.
+  const Scan2D facing_away = half_scan(room_walls(), pose2(0.0, 0.0, M_PI));
+  const Scan2D beside = half_scan(room_walls(), Pose2::Identity());
+  const std::vector<PosedScan2D> neighbours{{&beside, pose2(0.0, 0.0, M_PI)}};  // in facing_away's
+  const Pose2 in_facing_away = pose2(0.0, 0.0, M_PI).inverse() * truth;
+  const LoopVerification2D boxed =
+      verify_loop_2d(half_scan(with_box, truth), facing_away, in_facing_away, options, neighbours);
+  EXPECT_FALSE(boxed.accepted);
+  EXPECT_GT(boxed.free_violations, 0.08);
+  // And without the box the same place is a loop, though the candidate alone pairs nothing of the
+  // current scan (they look opposite ways): the way back then has no error or constraint to
+  // report, only its free space.
+  const LoopVerification2D loop =
+      verify_loop_2d(current, facing_away, in_facing_away, options, neighbours);
+  EXPECT_TRUE(loop.accepted) << loop.paired_fraction << " " << loop.error << " "
+                             << loop.free_violations << " " << loop.constraint;
+  EXPECT_LT((loop.transform.translation() - in_facing_away.translation()).norm(), 0.03);
 }
 
 TEST(LoopClosure2D, OptionsOutOfRangeAreRefused) {

@@ -367,6 +367,14 @@ TEST(Scan2D, CorrelativeSpreadIsLongAlongACorridorAndShowsABetterPoseElsewhere) 
       correlative_spread(corridor, corridor, Pose2::Identity(), 1.5, degrees2, 0.1, 1.0, 0.05);
   EXPECT_GT(std::sqrt(along.second_moment(0, 0)), 0.6);  // uniform over +-1.5 m: 0.87
   EXPECT_LT(std::sqrt(along.second_moment(1, 1)), 0.1);
+  EXPECT_TRUE(along.nearest.isApprox(Pose2::Identity()));  // nothing to move towards
+  // Asked for the fitting translation nearest a point off the corridor's axis: as far along as
+  // the point, on the axis (across, only y = 0 fits).
+  const CorrelativeSpread toward = correlative_spread(corridor, corridor, Pose2::Identity(), 1.5,
+                                                      degrees2, 0.1, 1.0, 0.05, Vec2(0.7, 0.4));
+  EXPECT_NEAR(toward.nearest.translation().x(), 0.7, 0.051);
+  EXPECT_NEAR(toward.nearest.translation().y(), 0.0, 0.051);
+  EXPECT_NEAR(pose2_angle(toward.nearest), 0.0, 1e-9);
   // A non-finite point lands nowhere and changes nothing.
   Scan2D with_nan = current;
   with_nan.points.emplace_back(std::nan(""), 1.0);
@@ -527,6 +535,40 @@ TEST(Map2D, WideSearchFindsATurnBeyondTheSearchAngle) {
   EXPECT_GT(std::abs(degrees(pose2_angle(narrow)) - 75.0), 20.0);
 }
 
+TEST(Map2D, SimulatedCorridorsKeepTheirStepsAndTurnTheirCorners) {
+  // corridor-2d (1 Hz, about 1 m per scan, corners of up to 80 degrees): along plain stretches
+  // the motion prior chooses the open steps; at a corner the prior (straight on) lies far from
+  // every fitting translation and must not choose.
+  const Scans2D input = load_scans_2d("sim:corridor-2d");
+  ASSERT_GT(input.scans.size(), 150u);
+  std::size_t from_prior = 0;
+  const auto ate = [&](const Mapper2DConfig& config) {
+    Mapper2D mapper(config);
+    std::vector<Pose2> estimate, reference;
+    from_prior = 0;
+    for (const LaserScan2D& laser : input.scans) {
+      estimate.push_back(mapper.add_scan(scan_from_laser(laser), laser.timestamp));
+      reference.push_back(pose2(laser.pose));
+      from_prior += mapper.last_stats().open_step_from_prior;
+    }
+    return absolute_trajectory_error_2d(reference, estimate).rmse;
+  };
+  Mapper2DConfig config;
+  config.registration.search_window = 1.3;  // map2d's default
+  const double prior = ate(config);
+  EXPECT_GT(from_prior, 0u);
+  config.open_step_prior_distance = 1e9;
+  const double ungated = ate(config);
+  config.open_step_window = 0.0;
+  const double left = ate(config);
+  EXPECT_EQ(from_prior, 0u);
+  std::printf("corridor-2d ATE: %.3f m with the prior, %.3f m ungated, %.3f m without\n", prior,
+              ungated, left);
+  EXPECT_LT(prior, 0.22);
+  EXPECT_LT(prior, 0.8 * left);
+  EXPECT_GT(ungated, 2.0 * prior);
+}
+
 TEST(Map2D, MapperRefusesOptionsOutOfRangeBeforeTheFirstScan) {
   // Caught per scan, they would bridge every scan silently instead.
   const auto refused = [](auto change) {
@@ -538,6 +580,8 @@ TEST(Map2D, MapperRefusesOptionsOutOfRangeBeforeTheFirstScan) {
   refused([](Mapper2DConfig& c) { c.registration.keep_fraction = 1.5; });
   refused([](Mapper2DConfig& c) { c.registration.method = "no-such-method"; });
   refused([](Mapper2DConfig& c) { c.wide_search_angle = -0.1; });
+  refused([](Mapper2DConfig& c) { c.open_step_window = -1.0; });
+  refused([](Mapper2DConfig& c) { c.open_step_prior_distance = std::nan(""); });
   EXPECT_NO_THROW(Mapper2D{Mapper2DConfig{}});
 }
 

@@ -69,6 +69,7 @@ py::dict stats_dict(const Scan2DStats& s) {
   d["pairs"] = s.pairs;
   d["error"] = s.error;
   d["bridged"] = s.bridged;
+  d["open_step_from_prior"] = s.open_step_from_prior;
   return d;
 }
 

@@ -50,6 +50,9 @@ class Planar(unittest.TestCase):
         self.assertGreater(np.linalg.norm(self.truth[-1, :2, 2]), 2.0)  # it did move
         self.assertLess(error.max(), 0.25)
         self.assertEqual(mapper.config["registration.max_iterations"], 50)
+        # room-2d's scans determine every step: the motion prior never has to choose.
+        self.assertFalse(any(s["open_step_from_prior"] for s in mapper.stats))
+        self.assertEqual(mapper.config["open_step_window"], 1.5)
 
     def test_errors(self):
         points, _ = self.scans[0]

@@ -68,23 +68,28 @@ class RangeProfile {
       r = std::max(r, p.norm());
     }
   }
-  /// True when `p` (in this scan's frame) lies more than `margin` in front of the return seen
-  /// along its bearing (and the neighbouring bins agree, so that an edge does not count).
+  /// True when `p` (in this scan's frame) lies more than `margin` in front of the returns seen
+  /// on both sides of its bearing (the nearest within kMaxGap bins each way, so that a beam
+  /// spacing coarser than a bin does not hide the free space and an edge does not count).
   bool in_free_space(const Eigen::Vector2d& p, double margin) const {
     const std::size_t b = bin(p);
     const double r = p.norm() + margin;
-    for (std::size_t d : {kBins - 1, std::size_t{0}, std::size_t{1}}) {
-      const double seen = ranges_[(b + d) % kBins];
-      if (seen < 0.0 || seen <= r) return false;
-    }
-    return true;
+    const double before = nearest_seen(b, kBins - 1), after = nearest_seen((b + 1) % kBins, 1);
+    return before > r && after > r;
   }
 
  private:
   static constexpr std::size_t kBins = 720;  // 0.5 deg
+  static constexpr std::size_t kMaxGap = 4;  // bins: a 1-degree laser missing one beam
   static std::size_t bin(const Eigen::Vector2d& p) {
     const double a = std::atan2(p.y(), p.x()) + M_PI;  // [0, 2 pi]
     return static_cast<std::size_t>(a / (2 * M_PI) * kBins) % kBins;
+  }
+  // The first return from bin `b` on, stepping by `step` (mod kBins); negative when none is near.
+  double nearest_seen(std::size_t b, std::size_t step) const {
+    for (std::size_t i = 0; i <= kMaxGap; ++i, b = (b + step) % kBins)
+      if (ranges_[b] >= 0.0) return ranges_[b];
+    return -1.0;
   }
   std::vector<double> ranges_;
 };
@@ -117,25 +122,36 @@ Eigen::Vector2d beam_normal(const Scan2D& scan, std::size_t j) {
 // What a scan is checked against: its surfaces filled between samples (as the correlative search
 // scores them: two scans sample a far wall metres apart, and sample-to-sample pairs would miss
 // true loops), hashed for the nearest pair, and the free space it saw. Built once per scan and
-// reused for every pose it is checked at.
+// reused for every pose it is checked at. Joined scans each saw their free space from their own
+// pose: the farthest return from the candidate's pose of a neighbour's point behind a wall says
+// nothing about the space in front of it.
 struct OverlapTarget {
   OverlapTarget(const Scan2D& onto, double pair_distance, double fill_gap)
+      : OverlapTarget(onto, {{&onto, Pose2::Identity()}}, pair_distance, fill_gap) {}
+  OverlapTarget(const Scan2D& onto, const std::vector<PosedScan2D>& views, double pair_distance,
+                double fill_gap)
       : surfaces(filled_surfaces(onto, fill_gap, 0.5 * pair_distance)),
-        hash(surfaces, pair_distance),
-        profile(onto.points) {}
+        hash(surfaces, pair_distance) {
+    for (const PosedScan2D& v : views) profiles.emplace_back(v.pose.inverse(), v.scan->points);
+  }
   OverlapTarget(const OverlapTarget&) = delete;  // `hash` refers to `surfaces`
   OverlapTarget& operator=(const OverlapTarget&) = delete;
 
+  bool in_free_space(const Eigen::Vector2d& p, double margin) const {
+    return std::any_of(profiles.begin(), profiles.end(), [&](const auto& view) {
+      return view.second.in_free_space(view.first * p, margin);
+    });
+  }
+
   std::vector<Eigen::Vector2d> surfaces;
   PointHash hash;
-  RangeProfile profile;
+  std::vector<std::pair<Pose2, RangeProfile>> profiles;  // into each view's frame, what it saw
 };
 
 // `from`'s points moved by `T` against `onto`'s surfaces and free space.
 OverlapCheck check_overlap(const Scan2D& from, const OverlapTarget& onto, const Pose2& T,
                            double free_margin) {
   const PointHash& hash = onto.hash;
-  const RangeProfile& profile = onto.profile;
   OverlapCheck c;
   std::size_t paired = 0, free = 0;
   double sum = 0.0;
@@ -151,7 +167,7 @@ OverlapCheck check_overlap(const Scan2D& from, const OverlapTarget& onto, const 
       const Eigen::Vector2d& p = from.points[j];
       const Eigen::Vector3d J(n.x(), n.y(), n.x() * -p.y() + n.y() * p.x());
       c.hessian += J * J.transpose();
-    } else if (profile.in_free_space(q, free_margin)) {
+    } else if (onto.in_free_space(q, free_margin)) {
       ++free;
     }
   }
@@ -177,7 +193,7 @@ Eigen::Matrix3d diagonal_information(double sigma_xy, double sigma_theta) {
 
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
                                   const Pose2& initial, const LoopVerification2DOptions& options,
-                                  const Scan2D* candidate_submap) {
+                                  const std::vector<PosedScan2D>& candidate_neighbours) {
   LoopVerification2D out;
   out.transform = initial;
   const std::size_t min_points = std::max<std::size_t>(options.min_points, 3);
@@ -188,7 +204,19 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
   r.method = options.method;
   r.max_correspondence_distance = options.max_correspondence_distance;
   r.search_window = 0.0;  // searched here, so that a place nothing fits ends the check early
-  const Scan2D& reference_scan = candidate_submap ? *candidate_submap : candidate;
+  const bool joined = !candidate_neighbours.empty();
+  Scan2D submap;
+  std::vector<PosedScan2D> views{{&candidate, Pose2::Identity()}};
+  if (joined) {
+    submap = candidate;
+    submap.circular = false;
+    for (const PosedScan2D& n : candidate_neighbours) {
+      if (!n.scan || !finite_scan(*n.scan) || !n.pose.matrix().allFinite()) continue;
+      for (const Eigen::Vector2d& p : n.scan->points) submap.points.push_back(n.pose * p);
+      views.push_back(n);
+    }
+  }
+  const Scan2D& reference_scan = joined ? submap : candidate;
   try {
     const CorrelativeMatch match = correlative_match(
         current, reference_scan, initial, options.search_window, options.search_angle,
@@ -200,18 +228,21 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
     return out;  // too few usable points for the method: not verifiable, so not a loop
   }
   if (!out.transform.matrix().allFinite()) return out;
-  const OverlapTarget reference(reference_scan, options.pair_distance, r.search_fill_gap);
+  const OverlapTarget reference(reference_scan, views, options.pair_distance, r.search_fill_gap);
   const OverlapCheck forward =
       check_overlap(current, reference, out.transform, options.free_margin);
   const OverlapCheck backward =
       check_overlap(candidate, OverlapTarget(current, options.pair_distance, r.search_fill_gap),
                     out.transform.inverse(), options.free_margin);
-  out.paired_fraction = candidate_submap
-                            ? forward.paired_fraction
-                            : std::min(forward.paired_fraction, backward.paired_fraction);
-  out.error = std::max(forward.error, backward.error);
+  out.paired_fraction = joined ? forward.paired_fraction
+                               : std::min(forward.paired_fraction, backward.paired_fraction);
+  // Against a submap the candidate alone may face away from the current scan and pair nothing:
+  // then the way back has no error or constraint to report, only its free space.
+  const bool backward_paired = !joined || backward.paired_fraction > 0.0;
+  out.error = backward_paired ? std::max(forward.error, backward.error) : forward.error;
   out.free_violations = std::max(forward.free_violations, backward.free_violations);
-  out.constraint = std::min(forward.constraint, backward.constraint);
+  out.constraint =
+      backward_paired ? std::min(forward.constraint, backward.constraint) : forward.constraint;
   out.hessian = forward.hessian;
   out.accepted = out.paired_fraction >= options.min_paired_fraction &&
                  out.error <= options.max_error &&
@@ -350,22 +381,17 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
   bool stale = false;
   for (const auto& [k, initial] : candidates) {
     ++counts_.candidates;
-    Scan2D submap;
+    std::vector<PosedScan2D> neighbours;
     if (options_.submap_keyframes > 0) {
-      submap = keyframes_[k].points;
       const std::size_t first = k > options_.submap_keyframes ? k - options_.submap_keyframes : 0;
       const std::size_t end = std::min(k + options_.submap_keyframes + 1, last_candidate);
-      for (std::size_t j = first; j < end; ++j) {
-        if (j == k) continue;
-        const Pose2 into_k = graph().pose(k).inverse() * graph().pose(j);
-        for (const Eigen::Vector2d& p : keyframes_[j].points.points)
-          submap.points.push_back(into_k * p);
-      }
-      submap.circular = false;
+      for (std::size_t j = first; j < end; ++j)
+        if (j != k)
+          neighbours.push_back(
+              {&keyframes_[j].points, graph().pose(k).inverse() * graph().pose(j)});
     }
-    const LoopVerification2D v =
-        verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points, initial,
-                       options_.verification, options_.submap_keyframes > 0 ? &submap : nullptr);
+    const LoopVerification2D v = verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points,
+                                                initial, options_.verification, neighbours);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;

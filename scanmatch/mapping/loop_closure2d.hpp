@@ -80,15 +80,22 @@ struct LoopVerification2D {
   double shifted_fraction = 0.0;
 };
 
+/// A scan and the pose it was taken from, in the frame of the scan it is joined to.
+struct PosedScan2D {
+  const Scan2D* scan = nullptr;
+  Pose2 pose = Pose2::Identity();
+};
+
 /// Verifies that `current` and `candidate` show the same place, starting from `initial` (current
 /// in the candidate's frame). Never throws for bad scans (too few or non-finite points): rejects.
-/// With `candidate_submap` (the candidate's scan joined by its neighbours', in the candidate's
-/// frame) the current scan is registered onto and paired against the submap, whose wider view a
+/// With `candidate_neighbours` (scans taken near the candidate, posed in its frame) the current
+/// scan is registered onto and paired against the candidate joined by them, whose wider view a
 /// 180-degree scan revisiting a place from elsewhere overlaps; the way back (candidate onto
-/// current) then checks only the error and the free space, not the paired share.
+/// current) then checks only the error and the free space, not the paired share. The free space
+/// is what each of those scans saw from where it was taken.
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
                                   const Pose2& initial, const LoopVerification2DOptions& options,
-                                  const Scan2D* candidate_submap = nullptr);
+                                  const std::vector<PosedScan2D>& candidate_neighbours = {});
 
 struct LoopClosure2DOptions {
   /// A new keyframe once the odometry has moved this far from the last one (m or rad). Every
@@ -127,7 +134,7 @@ struct LoopClosure2DOptions {
   std::size_t skip_recent = 30;
   /// The candidate keyframe's neighbours within this many keyframes either side (older than the
   /// skipped recent ones) join its scan as the verification's reference (verify_loop_2d's
-  /// candidate_submap). 0: scan against scan.
+  /// candidate_neighbours). 0: scan against scan.
   std::size_t submap_keyframes = 6;
   /// Loop edges hold what the match determines (its Hessian's shape at loop_sigma_xy), not the
   /// same certainty in every direction: a loop along a plain corridor holds nothing along it.

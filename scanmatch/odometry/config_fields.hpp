@@ -262,6 +262,14 @@ void describe(Mapper2DConfig& c, Visitor& v) {
     "rad: search again over +- this where few points fit (0: off)");
   v("wide_search_below", c.wide_search_below, nullptr,
     "share of points within 15 cm of the reference below which the wide search runs");
+  v("open_step_window", c.open_step_window, nullptr,
+    "m: where the scans leave a step open within this, the motion prior chooses (0: off)");
+  v("open_step_margin", c.open_step_margin, nullptr,
+    "share of the points: translations fitting within it of the best leave the step open");
+  v("open_step_spread", c.open_step_spread, nullptr,
+    "m: RMS spread of those translations from which the step counts as open");
+  v("open_step_prior_distance", c.open_step_prior_distance, nullptr,
+    "m: the prior chooses only when a fitting translation lies this near it");
   v.nested("registration", c.registration);
 }
 

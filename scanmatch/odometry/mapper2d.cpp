@@ -1,5 +1,6 @@
 #include "scanmatch/odometry/mapper2d.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 
 #include "scanmatch/core/error.hpp"
@@ -13,6 +14,11 @@ Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
   check_registration_2d_options(config.registration);
   if (!(config.wide_search_angle >= 0.0) || !(config.wide_search_below >= 0.0))
     throw Error("map2d: wide_search_angle and wide_search_below must not be negative");
+  if (!(config.open_step_window >= 0.0) || !(config.open_step_margin >= 0.0) ||
+      !(config.open_step_spread >= 0.0) || !(config.open_step_prior_distance >= 0.0))
+    throw Error(
+        "map2d: open_step_window, open_step_margin, open_step_spread and "
+        "open_step_prior_distance must not be negative");
 }
 
 bool Mapper2D::plausible_correction(const Pose2& correction) const {
@@ -63,6 +69,48 @@ Scan2D deskewed(const Scan2D& scan, const Pose2& motion, double interval) {
 
 }  // namespace
 
+// The spread's cells (m): coarse, as the spread costs the more the flatter the fit.
+constexpr double kOpenStepResolution = 0.1;
+
+Pose2 Mapper2D::prior_along_open_direction(const Scan2D& current, const Scan2D& reference,
+                                           const Pose2& registered, const Pose2& guess) {
+  if (!registered.matrix().allFinite()) return registered;
+  const CorrelativeSpread spread =
+      correlative_spread(current, reference, registered, config_.open_step_window, 2.0 * M_PI / 180,
+                         kOpenStepResolution, config_.registration.search_fill_gap,
+                         config_.open_step_margin, Eigen::Vector2d(guess.translation()));
+  if (spread.poses == 0 || !spread.second_moment.allFinite()) return registered;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(spread.second_moment);
+  if (eigen.eigenvalues()(1) < config_.open_step_spread * config_.open_step_spread)
+    return registered;
+  if ((spread.nearest.translation() - guess.translation()).norm() >
+      config_.open_step_prior_distance)
+    return registered;
+  // Along the open direction only: across it the registration is as good as the scans. Within a
+  // cell of the registered pose the scans' answer stands as it is.
+  const Eigen::Vector2d open = eigen.eigenvectors().col(1);
+  const double along = open.dot(spread.nearest.translation() - registered.translation());
+  if (std::abs(along) < kOpenStepResolution) return registered;
+  const Eigen::Vector2d moved = registered.translation() + along * open;
+  const Pose2 shifted = pose2(moved.x(), moved.y(), pose2_angle(registered));
+  // Registered again from there for the rotation and the across direction (the spread's axis is
+  // a cell-resolution estimate, a few degrees off: a metre along it drifts centimetres across),
+  // keeping only the across part of what the registration moves.
+  Registration2DOptions fine = config_.registration;
+  fine.search_window = 0.0;
+  Pose2 refined = shifted;
+  try {
+    refined = register_scans(current, reference, fine, shifted).transform;
+  } catch (const Error&) {
+  }
+  if (!refined.matrix().allFinite()) refined = shifted;
+  const Eigen::Vector2d across(-open.y(), open.x());
+  const Eigen::Vector2d result =
+      moved + across * across.dot(refined.translation() - shifted.translation());
+  stats_.open_step_from_prior = true;
+  return pose2(result.x(), result.y(), pose2_angle(refined));
+}
+
 Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   stats_ = {};
   stats_.points = input.points.size();
@@ -105,6 +153,8 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
         if (fit(current, w.transform) > narrow + 0.05) r = w;
       }
     }
+    if (config_.constant_velocity && config_.open_step_window > 0.0)
+      r.transform = prior_along_open_direction(current, reference, r.transform, guess);
     const Pose2 correction = guess.inverse() * r.transform;
     if (r.pairs >= 3 && r.transform.matrix().allFinite() && plausible_correction(correction)) {
       relative = r.transform;

@@ -44,6 +44,20 @@ struct Mapper2DConfig {
   /// Only when fewer than this share of the points fit after the first search (1: always; lower
   /// values save time but miss 90-degree errors, whose walls fit).
   double wide_search_below = 1.0;
+  /// Where the scans leave a step open (a corridor whose walls fit all along it, a junction that
+  /// fits two ways), they cannot choose and the registration settles wherever its own bias takes
+  /// it: on ACES (1 Hz) steps along corridors came out 0.1 or 2.3 m where the robot drove 1.1 m.
+  /// Within `open_step_window` (m) of the registered pose, the translations that fit within
+  /// `open_step_margin` (a share of the points) of the best one (correlative_spread) are all the
+  /// scans' answer; when they spread at least `open_step_spread` (m, RMS) the one nearest the
+  /// motion prior is taken along the open direction, the registered pose kept across it. Only
+  /// when that one lies within `open_step_prior_distance` (m) of the prior: farther, the scans
+  /// contradict the prior (the robot turned a corner or stopped) and the registration stands.
+  /// Needs `constant_velocity`. 0 (window): off.
+  double open_step_window = 1.5;
+  double open_step_margin = 0.05;
+  double open_step_spread = 0.3;
+  double open_step_prior_distance = 0.5;
 };
 
 struct Scan2DStats {
@@ -52,6 +66,8 @@ struct Scan2DStats {
   std::size_t points = 0, pairs = 0;
   double error = 0.0;    ///< mean distance of the final correspondences, m
   bool bridged = false;  ///< the scan could not be registered: the motion prior was used
+  /// The scans left the step open and the motion prior chose along it (open_step_window).
+  bool open_step_from_prior = false;
 };
 
 class Mapper2D {
@@ -70,6 +86,10 @@ class Mapper2D {
 
  private:
   bool plausible_correction(const Pose2& correction) const;
+  /// `registered` moved along the direction the scans leave open (if they do) to the fitting
+  /// translation nearest the motion prior `guess` (open_step_window).
+  Pose2 prior_along_open_direction(const Scan2D& current, const Scan2D& reference,
+                                   const Pose2& registered, const Pose2& guess);
 
   Mapper2DConfig config_;
   Scan2D keyframe_, last_scan_;

@@ -122,7 +122,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   OccupancyGrid grid(options.grid), reference_grid(options.grid);
   TrajectoryWriter poses(file("poses_tum.txt"), TrajectoryFormat::kTum);
   LineWriter timing(file("timing.csv"));
-  timing.line("scan,ms,iterations,points,pairs,error_m,bridged");
+  timing.line("scan,ms,iterations,points,pairs,error_m,bridged,open_step_from_prior");
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
@@ -162,8 +162,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     reference.push_back(pose2(laser.pose));
     poses.write(to_pose3(pose), laser.timestamp);
     char row[512];
-    std::snprintf(row, sizeof row, "%zu,%.4f,%d,%zu,%zu,%.6f,%d", i, s.ms, s.iterations, s.points,
-                  s.pairs, s.error, s.bridged ? 1 : 0);
+    std::snprintf(row, sizeof row, "%zu,%.4f,%d,%zu,%zu,%.6f,%d,%d", i, s.ms, s.iterations,
+                  s.points, s.pairs, s.error, s.bridged ? 1 : 0, s.open_step_from_prior ? 1 : 0);
     timing.line(row);
     // A trajectory that ran away (a failed method on hard data) can need more cells than the
     // grid allows: the run goes on and keeps its poses, without that map.
@@ -189,6 +189,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     reference_trajectory.poses.push_back(to_pose3(reference.front().inverse() * reference.back()));
     reference_trajectory.timestamps.push_back(laser.timestamp);
     summary.bridged += s.bridged;
+    summary.open_steps_from_prior += s.open_step_from_prior;
     summary.max_ms = std::max(summary.max_ms, s.ms);
     total_ms += s.ms;
     progress.update(i + 1);
@@ -313,6 +314,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       {"miss_range", options.miss_range}};
   j["scans"] = summary.scans;
   j["bridged"] = summary.bridged;
+  j["open_steps_from_prior"] = summary.open_steps_from_prior;
   j["interrupted"] = summary.interrupted;
   j["mean_ms"] = summary.mean_ms;
   j["max_ms"] = summary.max_ms;

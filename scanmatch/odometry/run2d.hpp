@@ -52,6 +52,7 @@ struct Map2DRunOptions {
 
 struct Map2DSummary {
   std::size_t scans = 0, bridged = 0;
+  std::size_t open_steps_from_prior = 0;  ///< steps the motion prior chose (open_step_window)
   double mean_ms = 0, max_ms = 0, scans_per_second = 0;
   bool interrupted = false, has_reference = false;
   RelativeError2D one_step, ten_steps;

@@ -398,10 +398,12 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
 
 CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
                                      const Pose2& at, double window, double angle_window,
-                                     double resolution, double fill_gap, double margin) {
+                                     double resolution, double fill_gap, double margin,
+                                     const std::optional<Eigen::Vector2d>& toward) {
   check_window(window, angle_window, resolution);
   if (!(margin >= 0.0)) throw Error("correlative search: the margin must not be negative");
   CorrelativeSpread spread;
+  spread.nearest = at;
   if (current.points.empty() || reference.points.empty()) return spread;
   const SearchSpace space =
       search_space(current, reference, at, window, angle_window, resolution, fill_gap);
@@ -418,26 +420,41 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
       for (int x = 0; x < space.span; x += kSide)
         blocks.push_back({space.score(a, kLevel, x, y), a, kLevel, x, y});
   std::sort(blocks.begin(), blocks.end(), higher_bound);
-  std::vector<float> best_of(static_cast<std::size_t>(space.span * space.span), 0.0f);
+  const auto cells = static_cast<std::size_t>(space.span * space.span);
+  std::vector<float> best_of(cells, 0.0f);
+  std::vector<int> best_angle(cells, 0);
   float best = 0.0f;
   for (const Block& block : blocks) {
     if (block.bound < best - allowance) break;
     for (int y = block.y; y < std::min(block.y + kSide, space.span); ++y)
       for (int x = block.x; x < std::min(block.x + kSide, space.span); ++x) {
-        float& cell = best_of[static_cast<std::size_t>(y * space.span + x)];
-        cell = std::max(cell, space.score(block.angle, 0, x, y));
-        best = std::max(best, cell);
+        const auto i = static_cast<std::size_t>(y * space.span + x);
+        const float score = space.score(block.angle, 0, x, y);
+        if (score > best_of[i]) {
+          best_of[i] = score;
+          best_angle[i] = block.angle;
+        }
+        best = std::max(best, score);
       }
   }
   spread.best_score = best / points;
   const float threshold = best - allowance;
   const double r = space.grid.resolution;
+  double nearest = std::numeric_limits<double>::infinity();
   for (int y = 0; y < space.span; ++y)
     for (int x = 0; x < space.span; ++x) {
-      if (best_of[static_cast<std::size_t>(y * space.span + x)] < threshold) continue;
+      const auto i = static_cast<std::size_t>(y * space.span + x);
+      if (best_of[i] < threshold) continue;
       const Eigen::Vector2d offset((x - space.half) * r, (y - space.half) * r);
       spread.second_moment += offset * offset.transpose();
       ++spread.poses;
+      if (toward) {
+        const double d = (at.translation() + offset - *toward).squaredNorm();
+        if (d < nearest) {
+          nearest = d;
+          spread.nearest = space.pose(best_angle[i], x, y);
+        }
+      }
     }
   if (spread.poses > 0) spread.second_moment /= static_cast<double>(spread.poses);
   return spread;

@@ -6,6 +6,8 @@
 // first, so most of the window is dismissed without looking at its cells.
 // register_scans runs it first when Registration2DOptions::search_window is set.
 
+#include <optional>
+
 #include "scanmatch/core/scan2d.hpp"
 
 namespace scanmatch {
@@ -45,6 +47,9 @@ struct CorrelativeSpread {
   Eigen::Matrix2d second_moment = Eigen::Matrix2d::Zero();
   double best_score = 0.0;  ///< the window's best, as a share of the best possible
   std::size_t poses = 0;    ///< translations counted (0: nothing could be scored)
+  /// With `toward`: the counted translation nearest to it, at its best rotation (the cells'
+  /// resolution); else, or when nothing counted, `at`.
+  Pose2 nearest = Pose2::Identity();
 };
 
 /// Every translation that can come within the margin is scored exactly (blocks of them bounded as
@@ -53,7 +58,8 @@ struct CorrelativeSpread {
 /// Throws Error unless the window and resolution are positive and the margin is not negative.
 CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
                                      const Pose2& at, double window, double angle_window,
-                                     double resolution, double fill_gap, double margin);
+                                     double resolution, double fill_gap, double margin,
+                                     const std::optional<Eigen::Vector2d>& toward = std::nullopt);
 
 /// The scan's points plus points every `step` (m) between beam neighbours up to `max_gap` apart
 /// that lie on one straight surface (a third neighbour on their line). Two scans sample a wall
