@@ -16,7 +16,7 @@ namespace {
 
 struct Map2DCommand {
   std::string sequence, out, initial = "constant-velocity", topic, config_file;
-  std::size_t scans = 0;
+  std::size_t scans = 0, first_scan = 0;
   std::uint64_t seed = 1;
   bool no_motion_distortion = false;
   double rotation_period = -1.0;  ///< s; negative: the input's own
@@ -81,6 +81,9 @@ void add_map2d_command(CLI::App& app) {
                   "New keyframe after this many deg of turn (0: not by angle)")
       ->capture_default_str();
   cmd->add_option("--scans", c->scans, "Process at most this many scans (0: all)");
+  cmd->add_option("--first-scan", c->first_scan,
+                  "Start at this scan (0-based), skipping the ones before it: a part of a log "
+                  "(its reference is then measured on that part alone)");
   cmd->add_option("--seed", c->seed, "Seed of sim: sequences")->capture_default_str();
   cmd->add_flag("--no-motion-distortion", c->no_motion_distortion,
                 "sim: sequences: measure each scan from its start pose");
@@ -94,7 +97,16 @@ void add_map2d_command(CLI::App& app) {
     input_options.topic = c->topic;
     input_options.simulator.seed = c->seed;
     input_options.simulator.motion_distortion = !c->no_motion_distortion;
-    Scans2D input = load_scans_2d(c->sequence, input_options, c->scans);
+    Scans2D input =
+        load_scans_2d(c->sequence, input_options, c->scans > 0 ? c->first_scan + c->scans : 0);
+    if (c->first_scan > 0) {
+      if (c->first_scan >= input.scans.size())
+        throw Error(fmt::format("map2d: {}: --first-scan {} but it has {} scans", c->sequence,
+                                c->first_scan, input.scans.size()));
+      input.scans.erase(input.scans.begin(),
+                        input.scans.begin() + static_cast<std::ptrdiff_t>(c->first_scan));
+      input.description += fmt::format(" (from scan {})", c->first_scan);
+    }
     if (c->rotation_period >= 0.0) input.rotation_period = c->rotation_period;
     Map2DSummary s;
     {

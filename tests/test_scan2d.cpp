@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics2d.hpp"
@@ -696,6 +697,33 @@ TEST(Map2D, CliWritesARunFolderAndRejectsBadInput) {
   std::size_t lines = 0;
   for (std::string l; std::getline(poses, l);) lines += !l.empty() && l[0] != '#';
   EXPECT_EQ(lines, 30u);
+  // A part of the input: scans 20-29, measured against the reference from scan 20 on.
+  const auto part = scanmatch::testing::run_cli(
+      "map2d sim:room-2d --first-scan 20 --scans 10 --quiet --out " + dir.file("part"));
+  ASSERT_EQ(part.status, 0) << part.output;
+  const auto tum_poses = [](const std::string& path) {
+    std::vector<Pose2> out;
+    std::ifstream in(path);
+    for (std::string l; std::getline(in, l);) {
+      if (l.empty() || l[0] == '#') continue;
+      std::istringstream row(l);
+      double t, x, y, z, qx, qy, qz, qw;
+      row >> t >> x >> y >> z >> qx >> qy >> qz >> qw;
+      out.push_back(pose2(x, y, 2.0 * std::atan2(qz, qw)));
+    }
+    return out;
+  };
+  const std::vector<Pose2> whole = tum_poses(dir.file("run/poses_reference_tum.txt"));
+  const std::vector<Pose2> from20 = tum_poses(dir.file("part/poses_reference_tum.txt"));
+  ASSERT_EQ(whole.size(), 30u);
+  ASSERT_EQ(from20.size(), 10u);
+  const Pose2 expected = whole[20].inverse() * whole[29];
+  EXPECT_LT((from20.back().translation() - expected.translation()).norm(), 1e-4);
+  EXPECT_LT(std::abs(pose2_angle(from20.back().inverse() * expected)), 1e-4);
+  const auto past_end = scanmatch::testing::run_cli(
+      "map2d sim:room-2d --first-scan 5000 --quiet --out " + dir.file("r6"));
+  EXPECT_NE(past_end.status, 0);
+  EXPECT_NE(past_end.output.find("--first-scan 5000"), std::string::npos) << past_end.output;
   scanmatch::testing::write_text(dir.file("bad.log"), "FLASER 3 1.0 nan\n");
   const auto bad = scanmatch::testing::run_cli("map2d " + dir.file("bad.log") + " --quiet --out " +
                                                dir.file("r2"));
