@@ -102,6 +102,7 @@ Pose2 Mapper2D::prior_along_open_direction(const Scan2D& current, const Scan2D& 
   try {
     refined = register_scans(current, reference, fine, shifted).transform;
   } catch (const Error&) {
+    // Too few usable points to register again: the shifted pose stands.
   }
   if (!refined.matrix().allFinite()) refined = shifted;
   const Eigen::Vector2d across(-open.y(), open.x());

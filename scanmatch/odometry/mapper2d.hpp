@@ -50,7 +50,8 @@ struct Mapper2DConfig {
   /// Within `open_step_window` (m) of the registered pose, the translations that fit within
   /// `open_step_margin` (a share of the points) of the best one (correlative_spread) are all the
   /// scans' answer; when they spread at least `open_step_spread` (m, RMS) the one nearest the
-  /// motion prior is taken along the open direction, the registered pose kept across it. Only
+  /// motion prior is taken along the open direction (registered again from there, for the
+  /// rotation and the part across it; last_stats().open_step_from_prior). Only
   /// when that one lies within `open_step_prior_distance` (m) of the prior: farther, the scans
   /// contradict the prior (the robot turned a corner or stopped) and the registration stands.
   /// Needs `constant_velocity`. 0 (window): off.
