@@ -189,6 +189,7 @@ struct SearchSpace {
 SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
                          double window, double angle_window, double resolution, double fill_gap) {
   SearchSpace space;
+  if (current.points.empty() || reference.points.empty()) return space;  // nothing to score
   std::vector<Vec2>& points = space.points;
   // A non-finite point lands nowhere; dropped here, before any conversion to a cell.
   std::vector<Vec2> finite;
@@ -306,7 +307,6 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
     throw Error("correlative search: the minimum score must be in [0, 1]");
   CorrelativeMatch match;
   match.pose = initial;
-  if (current.points.empty() || reference.points.empty()) return match;
   const SearchSpace space =
       search_space(current, reference, initial, window, angle_window, resolution, fill_gap);
   if (space.cells.empty()) return match;
@@ -404,7 +404,6 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
   if (!(margin >= 0.0)) throw Error("correlative search: the margin must not be negative");
   CorrelativeSpread spread;
   spread.nearest = at;
-  if (current.points.empty() || reference.points.empty()) return spread;
   const SearchSpace space =
       search_space(current, reference, at, window, angle_window, resolution, fill_gap);
   if (space.cells.empty()) return spread;
