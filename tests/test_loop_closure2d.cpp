@@ -198,6 +198,34 @@ TEST(LoopClosure2D, AStepAPlainCorridorLeavesOpenIsHeldLooselyAlongIt) {
   EXPECT_EQ(fixed.counts().open_odometry_edges, 0u);
 }
 
+TEST(LoopClosure2D, AnOpenStepThatTurnsIsLooseAlongTheCorridorNotAlongItsTurnedFrame) {
+  // The scans fit anywhere along the previous keyframe's x (a corridor), and the robot turned 60
+  // degrees during the step (ACES's wrong step turned 41). Another edge pulls the step 1 m along
+  // that corridor: the open edge must give way along it and hold across it, whatever the turn.
+  const double sigma_xy = 0.05, sigma_theta = 0.5 * M_PI / 180;
+  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+  spread(0, 0) = 1.0;  // m^2 along x, nothing across
+  for (const double turn : {0.0, 60.0 * M_PI / 180, -120.0 * M_PI / 180}) {
+    const Pose2 measured = pose2(0.1, 0.0, turn);
+    const Eigen::Matrix3d open =
+        spread_odometry_information(spread, measured, sigma_xy, sigma_theta, 0.1);
+    PoseGraph2D graph;
+    graph.add_node(Pose2::Identity());
+    graph.add_node(measured);
+    graph.add_edge(0, 1, measured, open, EdgeKind::kOdometry);
+    const Eigen::Vector3d firm(1 / (sigma_xy * sigma_xy), 1 / (sigma_xy * sigma_xy),
+                               1 / (sigma_theta * sigma_theta));
+    graph.add_edge(0, 1, pose2(1.1, 0.0, turn), firm.asDiagonal(), EdgeKind::kOdometry);
+    graph.optimize();
+    EXPECT_NEAR(graph.pose(1).translation().x(), 1.1, 0.05) << "turn " << turn;
+    EXPECT_NEAR(graph.pose(1).translation().y(), 0.0, 0.01) << "turn " << turn;
+    // Without a spread: the fixed sigmas.
+    EXPECT_TRUE(
+        spread_odometry_information(Eigen::Matrix2d::Zero(), measured, sigma_xy, sigma_theta, 0.1)
+            .isApprox(firm.asDiagonal().toDenseMatrix()));
+  }
+}
+
 TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
   // Walls at y = +-1.2 m with a 0.6 m wide, 0.3 m deep door recess every 2 m on both sides, seen
   // by a 180-degree laser (1 deg beams, 30 m). A scan matched 2 m along (one door further) fits as

@@ -431,12 +431,28 @@ Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) 
                                     fallback);
 }
 
+Eigen::Matrix3d spread_odometry_information(const Eigen::Matrix2d& spread, const Pose2& measurement,
+                                            double sigma_xy, double sigma_theta, double normal) {
+  Eigen::Matrix3d information = diagonal_information(sigma_xy, sigma_theta);
+  if (!spread.allFinite()) return information;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(0.5 * (spread + spread.transpose()));
+  const Eigen::Vector2d widened =
+      (eigen.eigenvalues().array() - normal * normal).max(0.0) + sigma_xy * sigma_xy;
+  if (widened.maxCoeff() <= sigma_xy * sigma_xy) return information;
+  // The spread lies in the previous keyframe's frame, the edge's residual in the measured step's
+  // end frame (pose_graph.hpp): turned by the step's rotation, or a 40-degree turn loosens a
+  // direction 40 degrees off the open one.
+  const Eigen::Matrix2d to_residual = measurement.rotation().transpose();
+  information.topLeftCorner<2, 2>() = to_residual * eigen.eigenvectors() *
+                                      widened.cwiseInverse().asDiagonal() *
+                                      eigen.eigenvectors().transpose() * to_residual.transpose();
+  return information;
+}
+
 LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
     const Scan2D& previous, const Scan2D& current, const Pose2& measurement) const {
-  const double sigma = options_.odometry_sigma_xy;
   OdometryInformation out;
-  Eigen::Matrix3d& information = out.information;
-  information = diagonal_information(sigma, options_.odometry_sigma_theta);
+  out.information = diagonal_information(options_.odometry_sigma_xy, options_.odometry_sigma_theta);
   if (!(options_.odometry_spread_window > 0.0)) return out;
   // A small angle window: the rotation is what scans determine best; it lets each translation
   // find its fit where the step's rotation is a little off.
@@ -444,14 +460,14 @@ LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
       current, previous, measurement, options_.odometry_spread_window, 2.0 * M_PI / 180, 0.1,
       Registration2DOptions{}.search_fill_gap, options_.odometry_spread_margin);
   if (spread.poses == 0 || !spread.second_moment.allFinite()) return out;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(spread.second_moment);
-  const double normal = options_.odometry_spread_normal * options_.odometry_spread_normal;
-  const Eigen::Vector2d widened = (eigen.eigenvalues().array() - normal).max(0.0) + sigma * sigma;
-  if (widened.maxCoeff() <= sigma * sigma) return out;
-  out.open =
-      eigen.eigenvalues().maxCoeff() >= options_.open_step_spread * options_.open_step_spread;
-  information.topLeftCorner<2, 2>() =
-      eigen.eigenvectors() * widened.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
+  out.information =
+      spread_odometry_information(spread.second_moment, measurement, options_.odometry_sigma_xy,
+                                  options_.odometry_sigma_theta, options_.odometry_spread_normal);
+  const double largest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(spread.second_moment, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .maxCoeff();
+  out.open = largest >= options_.open_step_spread * options_.open_step_spread;
   return out;
 }
 

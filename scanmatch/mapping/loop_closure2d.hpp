@@ -187,6 +187,14 @@ struct LoopClosure2DCounts {
   double total_ms = 0.0;  ///< wall time spent in add_scan() and finish()
 };
 
+/// The information of an odometry edge (x, y, theta in the pose graph's residual frame) whose
+/// step measures `measurement` (current in the previous keyframe's frame): standard deviations
+/// `sigma_xy` and `sigma_theta`, the translation widened by the part of the fitting translations'
+/// `spread` (their second moment about the step, m^2, in the previous keyframe's frame:
+/// CorrelativeSpread::second_moment) beyond `normal` (m) in each of its directions.
+Eigen::Matrix3d spread_odometry_information(const Eigen::Matrix2d& spread, const Pose2& measurement,
+                                            double sigma_xy, double sigma_theta, double normal);
+
 class LoopClosure2D {
  public:
   /// Throws Error for an unknown registration method or options out of range.
