@@ -143,7 +143,9 @@ struct LoopClosure2DOptions {
   /// same certainty in every direction: a loop along a plain corridor holds nothing along it.
   bool hessian_loop_information = true;
   /// Pose-proximity candidates: earlier keyframes within this distance (m) of the new one in the
-  /// current estimate, nearest first, at most `max_proximity_candidates` (0: none).
+  /// current estimate, nearest first, at most `max_proximity_candidates` (0: none), each at least
+  /// skip_recent / 2 + 1 keyframes from the others (not two neighbours of one visit; with the
+  /// default skip_recent, 2).
   double proximity_radius = 4.0;
   std::size_t max_proximity_candidates = 2;
   /// Place-database candidates below this descriptor distance, at most this many (0: none).
