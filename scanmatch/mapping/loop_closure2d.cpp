@@ -223,7 +223,7 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
         options.search_resolution, r.search_fill_gap, options.min_search_score);
     out.search_score = match.score;
     if (!match.found) return out;
-    out.transform = register_scans(current, reference_scan, r, match.pose).transform;
+    out.transform = refine_searched(current, reference_scan, r, match.pose).transform;
   } catch (const Error&) {
     return out;  // too few usable points for the method: not verifiable, so not a loop
   }

@@ -244,6 +244,8 @@ void describe(Registration2DOptions& r, Visitor& v) {
   v("search_resolution", r.search_resolution, nullptr, "correlative search grid, m");
   v("search_fill_gap", r.search_fill_gap, "--search-fill-gap",
     "Correlative search: fill straight surfaces between returns up to this many m apart (0: off)");
+  v("fine_fit_margin", r.fine_fit_margin, nullptr,
+    "m: after the search, the method's pose must fit within this of the search's (<0: off)");
   v.nested("path_rules", r.path_rules);
 }
 

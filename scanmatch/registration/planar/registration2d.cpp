@@ -1,6 +1,10 @@
 #include "scanmatch/registration/planar/registration2d.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 
 namespace scanmatch {
@@ -90,12 +94,63 @@ Registration2DResult register_scans(const Scan2D& current, const Scan2D& referen
   check_registration_2d_options(o);
   check_scan(current, "current", method.min_points);
   check_scan(reference, "reference", method.min_points);
-  const Pose2 start =
-      o.search_window > 0.0
-          ? correlative_search(current, reference, initial, o.search_window, o.search_angle,
-                               o.search_resolution, o.search_fill_gap)
-          : initial;
-  return method.run(current, reference, o, start);
+  if (!(o.search_window > 0.0)) return method.run(current, reference, o, initial);
+  const Pose2 searched = correlative_search(current, reference, initial, o.search_window,
+                                            o.search_angle, o.search_resolution, o.search_fill_gap);
+  return refine_searched(current, reference, o, searched);
+}
+
+double surface_distance(const Scan2D& current, const Scan2D& reference, const Pose2& pose,
+                        double max_gap, double cap) {
+  if (current.points.empty()) return cap;
+  if (reference.points.empty()) return cap;
+  const KdTree2 tree(reference.points);
+  const auto to_segment = [](const Eigen::Vector2d& q, const Eigen::Vector2d& a,
+                             const Eigen::Vector2d& b) {
+    const Eigen::Vector2d ab = b - a;
+    const double t = std::clamp((q - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+    return (a + t * ab - q).norm();
+  };
+  double sum = 0.0;
+  for (const Eigen::Vector2d& p : current.points) {
+    const Eigen::Vector2d q = pose * p;
+    std::size_t k = 0;
+    double squared = 0.0;
+    double d = cap;
+    // The nearest sample's segments: a point between two samples of a wall is nearest to one of
+    // them.
+    if (tree.nearest(q, (cap + max_gap) * (cap + max_gap), k, squared)) {
+      d = std::sqrt(squared);
+      for (const long step : {-1L, 1L}) {
+        const long n = beam_neighbour(reference, k, step);
+        if (n < 0) continue;
+        const Eigen::Vector2d& a = reference.points[k];
+        const Eigen::Vector2d& b = reference.points[static_cast<std::size_t>(n)];
+        if ((b - a).norm() <= max_gap) d = std::min(d, to_segment(q, a, b));
+      }
+    }
+    sum += std::min(d, cap);
+  }
+  return sum / static_cast<double>(current.points.size());
+}
+
+Registration2DResult refine_searched(const Scan2D& current, const Scan2D& reference,
+                                     const Registration2DOptions& o, const Pose2& searched) {
+  const Registration2DMethod& method = registration_2d_method(o.method);
+  check_registration_2d_options(o);
+  check_scan(current, "current", method.min_points);
+  check_scan(reference, "reference", method.min_points);
+  Registration2DResult r = method.run(current, reference, o, searched);
+  if (o.fine_fit_margin < 0.0) return r;
+  const bool worse =
+      !r.transform.matrix().allFinite() ||
+      surface_distance(current, reference, r.transform, o.search_fill_gap) >
+          surface_distance(current, reference, searched, o.search_fill_gap) + o.fine_fit_margin;
+  if (worse) {
+    r.transform = searched;
+    r.search_pose_kept = true;
+  }
+  return r;
 }
 
 }  // namespace scanmatch

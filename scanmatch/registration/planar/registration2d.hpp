@@ -92,6 +92,11 @@ struct Registration2DOptions {
   /// The search fills the reference's straight surfaces between beam neighbours up to this far
   /// apart (filled_surfaces in correlative_search.hpp), m; 0: scores against the samples alone.
   double search_fill_gap = 1.0;
+  /// After the search, the method's pose replaces the search's only if the scans' mean surface
+  /// distance there (surface_distance) is at most this much (m) above the search pose's; else the
+  /// search's pose stands. In cluttered close-range scans (a dead end, people round the robot)
+  /// sparse-icp sometimes walks 4-20 degrees off a good start (docs/planar.md). Negative: off.
+  double fine_fit_margin = 0.001;
 };
 
 struct Registration2DResult {
@@ -100,6 +105,8 @@ struct Registration2DResult {
   double error = 0.0;     ///< mean distance of the final correspondences, m
   std::size_t pairs = 0;  ///< correspondences used in the last step
   bool converged = false;
+  /// The method's pose fitted worse than the search's (fine_fit_margin), which was kept.
+  bool search_pose_kept = false;
 };
 
 /// How a method runs: `current` onto `reference` from `initial`, with checked options and scans.
@@ -117,6 +124,18 @@ struct Registration2DMethod {
 /// The 2D methods, in the order the CLI lists them; the first is the default.
 const std::vector<Registration2DMethod>& registration_2d_methods();
 const std::vector<std::string>& registration_2d_method_names();
+/// The mean distance (m) from `current`'s points under `pose` to `reference`'s surfaces (the
+/// segments between beam neighbours up to `max_gap` apart, else its points), each capped at `cap`:
+/// a fit that compares poses the methods reached by different costs.
+double surface_distance(const Scan2D& current, const Scan2D& reference, const Pose2& pose,
+                        double max_gap, double cap = 0.2);
+
+/// The method run from `searched` (a correlative search's pose), kept only where it fits no worse
+/// than `searched` by fine_fit_margin (else `searched` with search_pose_kept set).
+/// options.search_window is ignored.
+Registration2DResult refine_searched(const Scan2D& current, const Scan2D& reference,
+                                     const Registration2DOptions& options, const Pose2& searched);
+
 /// "sparse-icp, icp, ...": the names for help texts and errors.
 std::string registration_2d_method_list();
 /// The method named `name`; throws Error naming the valid methods when there is none.
@@ -128,8 +147,8 @@ void check_registration_2d_method(const std::string& method);
 void check_registration_2d_options(const Registration2DOptions& options);
 
 /// Registers `current` onto `reference` from `initial` (after the correlative search, when
-/// `search_window` is set). Throws Error for an unknown method, options out of range, or scans
-/// too small to register.
+/// `search_window` is set, and then as refine_searched). Throws Error for an unknown method,
+/// options out of range, or scans too small to register.
 Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
                                     const Registration2DOptions& options,
                                     const Pose2& initial = Pose2::Identity());
