@@ -441,6 +441,7 @@ TEST(Scan2D, BadInputGivesClearErrors) {
   refused([](Registration2DOptions& b) { b.keep_fraction = 1.5; });
   refused([](Registration2DOptions& b) { b.sparse_min_pairs = 1.0; });
   refused([](Registration2DOptions& b) { b.search_fill_gap = -1.0; });
+  refused([](Registration2DOptions& b) { b.fine_fit_margin = std::nan(""); });
   for (const auto shared :
        {PathRules::Shared::drop, PathRules::Shared::keep_nearest, PathRules::Shared::keep_all})
     EXPECT_EQ(parse_shared_rows(to_string(shared)), shared);

@@ -24,6 +24,16 @@ void check_scan(const Scan2D& scan, const char* which, std::size_t min_points) {
       throw Error(std::string("2D registration: the ") + which + " scan has a non-finite point");
 }
 
+/// The options' method, after checking the options and both scans.
+const Registration2DMethod& checked_method(const Scan2D& current, const Scan2D& reference,
+                                           const Registration2DOptions& o) {
+  const Registration2DMethod& method = registration_2d_method(o.method);
+  check_registration_2d_options(o);
+  check_scan(current, "current", method.min_points);
+  check_scan(reference, "reference", method.min_points);
+  return method;
+}
+
 }  // namespace
 
 const std::vector<Registration2DMethod>& registration_2d_methods() {
@@ -86,14 +96,13 @@ void check_registration_2d_options(const Registration2DOptions& o) {
     throw Error("2D registration: sparse_min_pairs must be in [0, 1)");
   if (!(o.search_fill_gap >= 0.0))
     throw Error("2D registration: search_fill_gap must not be negative");
+  if (std::isnan(o.fine_fit_margin))
+    throw Error("2D registration: fine_fit_margin must be a number (negative: off)");
 }
 
 Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
                                     const Registration2DOptions& o, const Pose2& initial) {
-  const Registration2DMethod& method = registration_2d_method(o.method);
-  check_registration_2d_options(o);
-  check_scan(current, "current", method.min_points);
-  check_scan(reference, "reference", method.min_points);
+  const Registration2DMethod& method = checked_method(current, reference, o);
   if (!(o.search_window > 0.0)) return method.run(current, reference, o, initial);
   const Pose2 searched = correlative_search(current, reference, initial, o.search_window,
                                             o.search_angle, o.search_resolution, o.search_fill_gap);
@@ -136,10 +145,7 @@ double surface_distance(const Scan2D& current, const Scan2D& reference, const Po
 
 Registration2DResult refine_searched(const Scan2D& current, const Scan2D& reference,
                                      const Registration2DOptions& o, const Pose2& searched) {
-  const Registration2DMethod& method = registration_2d_method(o.method);
-  check_registration_2d_options(o);
-  check_scan(current, "current", method.min_points);
-  check_scan(reference, "reference", method.min_points);
+  const Registration2DMethod& method = checked_method(current, reference, o);
   Registration2DResult r = method.run(current, reference, o, searched);
   if (o.fine_fit_margin < 0.0) return r;
   const bool worse =
