@@ -92,6 +92,9 @@ void bind_planar(py::module_& m) {
           "error", [](const R& r) { return r.result.error; },
           "mean distance of the final correspondences, m")
       .def_property_readonly("pairs", [](const R& r) { return r.result.pairs; })
+      .def_property_readonly(
+          "search_pose_kept", [](const R& r) { return r.result.search_pose_kept; },
+          "the method fitted worse than the correlative search's pose, which was kept")
       .def("__repr__", [](const R& r) {
         const Pose2& T = r.result.transform;
         return "<scanmatch.Registration2DResult " + r.method + ": x " +

@@ -34,6 +34,11 @@ class Planar(unittest.TestCase):
                 self.assertLess(np.linalg.norm(result.transform[:2, 2] - truth[:2, 2]), 0.01)
                 angle = np.arctan2(truth[1, 0], truth[0, 0])
                 self.assertLess(abs(result.theta - angle), np.radians(0.5))
+                searched = scanmatch.register2d(current, reference, method=method, circular=True,
+                                                search_window=1.0)
+                # A clean pair: the method refines the search's pose, which is not kept.
+                self.assertFalse(searched.search_pose_kept)
+                self.assertLess(np.linalg.norm(searched.transform[:2, 2] - truth[:2, 2]), 0.01)
         # An initial guess as (x, y, theta) and as a matrix give the same result.
         a = scanmatch.register2d(current, reference, initial=(0.2, 0.0, 0.15), circular=True)
         b = scanmatch.register2d(current, reference, circular=True,
