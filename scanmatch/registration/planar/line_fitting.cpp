@@ -1,5 +1,6 @@
 #include "scanmatch/registration/planar/line_fitting.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace scanmatch {
@@ -57,6 +58,35 @@ std::vector<FittedLine> fit_scan_lines(const Scan2D& scan, double radius, double
     }
   }
   return lines;
+}
+
+std::optional<SegmentProjection> project_onto_neighbour_segments(const Scan2D& reference,
+                                                                 std::size_t j, const Vec2& p,
+                                                                 double max_length) {
+  const Vec2& q = reference.points[j];
+  SegmentProjection best{q, Vec2::Zero()};
+  double best_squared = (p - q).squaredNorm();
+  int segments = 0;
+  bool beyond = false;
+  for (const long step : {-1L, 1L}) {
+    const long k = beam_neighbour(reference, j, step);
+    if (k < 0) continue;
+    const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
+    const double length_squared = d.squaredNorm();
+    if (length_squared < 1e-18 || length_squared > max_length * max_length) continue;
+    ++segments;
+    const double along = (p - q).dot(d) / length_squared;
+    beyond = along < 0.0;
+    const Vec2 candidate = q + std::clamp(along, 0.0, 1.0) * d;
+    const double squared = (p - candidate).squaredNorm();
+    // The first usable segment always counts (its nearest point is never farther than j).
+    if (squared < best_squared || best.normal.isZero()) {
+      best_squared = squared;
+      best = {candidate, Vec2(-d.y(), d.x()) / std::sqrt(length_squared)};
+    }
+  }
+  if (segments == 1 && beyond) return std::nullopt;
+  return best;
 }
 
 }  // namespace scanmatch

@@ -6,6 +6,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
+#include "scanmatch/registration/planar/line_fitting.hpp"
 
 namespace scanmatch {
 
@@ -100,63 +101,76 @@ void check_registration_2d_options(const Registration2DOptions& o) {
     throw Error("2D registration: fine_fit_margin must be a number (negative: off)");
 }
 
+namespace {
+
+/// surface_distance against one reference, its k-d tree built once for any number of poses.
+class SurfaceDistance {
+ public:
+  SurfaceDistance(const Scan2D& reference, double max_gap, double cap)
+      : reference_(reference), tree_(reference.points), max_gap_(max_gap), cap_(cap) {}
+
+  double operator()(const Scan2D& current, const Pose2& pose) const {
+    if (current.points.empty() || reference_.points.empty()) return cap_;
+    const double radius = cap_ + max_gap_;
+    double sum = 0.0;
+    for (const Eigen::Vector2d& p : current.points) {
+      const Eigen::Vector2d q = pose * p;
+      std::size_t k = 0;
+      double squared = 0.0;
+      double d = cap_;
+      // The nearest sample's segments: a point between two samples of a wall is nearest to one
+      // of them. Beyond a surface's end the end itself is the nearest.
+      if (tree_.nearest(q, radius * radius, k, squared)) {
+        const auto projected = project_onto_neighbour_segments(reference_, k, q, max_gap_);
+        d = projected ? (projected->point - q).norm() : std::sqrt(squared);
+      }
+      sum += std::min(d, cap_);
+    }
+    return sum / static_cast<double>(current.points.size());
+  }
+
+ private:
+  const Scan2D& reference_;
+  KdTree2 tree_;
+  double max_gap_, cap_;
+};
+
+/// refine_searched once the options and scans are checked.
+Registration2DResult refine_checked(const Registration2DMethod& method, const Scan2D& current,
+                                    const Scan2D& reference, const Registration2DOptions& o,
+                                    const Pose2& searched) {
+  Registration2DResult r = method.run(current, reference, o, searched);
+  if (o.fine_fit_margin < 0.0) return r;
+  const SurfaceDistance distance(reference, o.search_fill_gap, kSurfaceDistanceCap);
+  const bool worse =
+      !r.transform.matrix().allFinite() ||
+      distance(current, r.transform) > distance(current, searched) + o.fine_fit_margin;
+  if (worse) {
+    r.transform = searched;
+    r.search_pose_kept = true;
+  }
+  return r;
+}
+
+}  // namespace
+
 Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
                                     const Registration2DOptions& o, const Pose2& initial) {
   const Registration2DMethod& method = checked_method(current, reference, o);
   if (!(o.search_window > 0.0)) return method.run(current, reference, o, initial);
   const Pose2 searched = correlative_search(current, reference, initial, o.search_window,
                                             o.search_angle, o.search_resolution, o.search_fill_gap);
-  return refine_searched(current, reference, o, searched);
+  return refine_checked(method, current, reference, o, searched);
 }
 
 double surface_distance(const Scan2D& current, const Scan2D& reference, const Pose2& pose,
                         double max_gap, double cap) {
-  if (current.points.empty()) return cap;
-  if (reference.points.empty()) return cap;
-  const KdTree2 tree(reference.points);
-  const auto to_segment = [](const Eigen::Vector2d& q, const Eigen::Vector2d& a,
-                             const Eigen::Vector2d& b) {
-    const Eigen::Vector2d ab = b - a;
-    const double t = std::clamp((q - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
-    return (a + t * ab - q).norm();
-  };
-  double sum = 0.0;
-  for (const Eigen::Vector2d& p : current.points) {
-    const Eigen::Vector2d q = pose * p;
-    std::size_t k = 0;
-    double squared = 0.0;
-    double d = cap;
-    // The nearest sample's segments: a point between two samples of a wall is nearest to one of
-    // them.
-    if (tree.nearest(q, (cap + max_gap) * (cap + max_gap), k, squared)) {
-      d = std::sqrt(squared);
-      for (const long step : {-1L, 1L}) {
-        const long n = beam_neighbour(reference, k, step);
-        if (n < 0) continue;
-        const Eigen::Vector2d& a = reference.points[k];
-        const Eigen::Vector2d& b = reference.points[static_cast<std::size_t>(n)];
-        if ((b - a).norm() <= max_gap) d = std::min(d, to_segment(q, a, b));
-      }
-    }
-    sum += std::min(d, cap);
-  }
-  return sum / static_cast<double>(current.points.size());
+  return SurfaceDistance(reference, max_gap, cap)(current, pose);
 }
 
 Registration2DResult refine_searched(const Scan2D& current, const Scan2D& reference,
                                      const Registration2DOptions& o, const Pose2& searched) {
-  const Registration2DMethod& method = checked_method(current, reference, o);
-  Registration2DResult r = method.run(current, reference, o, searched);
-  if (o.fine_fit_margin < 0.0) return r;
-  const bool worse =
-      !r.transform.matrix().allFinite() ||
-      surface_distance(current, reference, r.transform, o.search_fill_gap) >
-          surface_distance(current, reference, searched, o.search_fill_gap) + o.fine_fit_margin;
-  if (worse) {
-    r.transform = searched;
-    r.search_pose_kept = true;
-  }
-  return r;
+  return refine_checked(checked_method(current, reference, o), current, reference, o, searched);
 }
 
 }  // namespace scanmatch

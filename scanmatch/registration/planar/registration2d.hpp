@@ -127,8 +127,9 @@ const std::vector<std::string>& registration_2d_method_names();
 /// The mean distance (m) from `current`'s points under `pose` to `reference`'s surfaces (the
 /// segments between beam neighbours up to `max_gap` apart, else its points), each capped at `cap`:
 /// a fit that compares poses the methods reached by different costs.
+inline constexpr double kSurfaceDistanceCap = 0.2;  ///< m, surface_distance's default cap
 double surface_distance(const Scan2D& current, const Scan2D& reference, const Pose2& pose,
-                        double max_gap, double cap = 0.2);
+                        double max_gap, double cap = kSurfaceDistanceCap);
 
 /// The method run from `searched` (a correlative search's pose), kept only where it fits no worse
 /// than `searched` by fine_fit_margin (else `searched` with search_pose_kept set).

@@ -17,45 +17,6 @@ namespace {
 
 using Vec2 = Eigen::Vector2d;
 
-/// The nearest point to `p` on the segments from reference point j to its beam-order neighbours,
-/// and the unit normal of that segment (zero when j has no usable segment: the point is then j
-/// itself). Segments longer than `max_length` span a gap, not a surface, and are not used.
-struct SegmentProjection {
-  Vec2 point, normal;
-};
-
-/// Empty when j ends a surface and `p` lies beyond that end: such a point has no counterpart in
-/// the reference (the edge of the range, an occlusion), and pairing it with the end would pull
-/// the scan back along the surface, a bias that builds up along a corridor.
-std::optional<SegmentProjection> project_onto_neighbour_segments(const Scan2D& reference,
-                                                                 std::size_t j, const Vec2& p,
-                                                                 double max_length) {
-  const Vec2& q = reference.points[j];
-  SegmentProjection best{q, Vec2::Zero()};
-  double best_squared = (p - q).squaredNorm();
-  int segments = 0;
-  bool beyond = false;
-  for (const long step : {-1L, 1L}) {
-    const long k = beam_neighbour(reference, j, step);
-    if (k < 0) continue;
-    const Vec2 d = reference.points[static_cast<std::size_t>(k)] - q;
-    const double length_squared = d.squaredNorm();
-    if (length_squared < 1e-18 || length_squared > max_length * max_length) continue;
-    ++segments;
-    const double along = (p - q).dot(d) / length_squared;
-    beyond = along < 0.0;
-    const Vec2 candidate = q + std::clamp(along, 0.0, 1.0) * d;
-    const double squared = (p - candidate).squaredNorm();
-    // The first usable segment always counts (its nearest point is never farther than j).
-    if (squared < best_squared || best.normal.isZero()) {
-      best_squared = squared;
-      best = {candidate, Vec2(-d.y(), d.x()) / std::sqrt(length_squared)};
-    }
-  }
-  if (segments == 1 && beyond) return std::nullopt;
-  return best;
-}
-
 }  // namespace
 
 Pose2 coarse_alignment_2d(const std::vector<Vec2>& current, const std::vector<Vec2>& reference,
