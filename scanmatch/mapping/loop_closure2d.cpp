@@ -456,9 +456,10 @@ LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
   if (!(options_.odometry_spread_window > 0.0)) return out;
   // A small angle window: the rotation is what scans determine best; it lets each translation
   // find its fit where the step's rotation is a little off.
-  const CorrelativeSpread spread = correlative_spread(
-      current, previous, measurement, options_.odometry_spread_window, 2.0 * M_PI / 180, 0.1,
-      Registration2DOptions{}.search_fill_gap, options_.odometry_spread_margin);
+  const CorrelativeSpread spread =
+      correlative_spread(current, previous, measurement, options_.odometry_spread_window,
+                         kStepSpreadAngle, kStepSpreadResolution,
+                         Registration2DOptions{}.search_fill_gap, options_.odometry_spread_margin);
   if (spread.poses == 0 || !spread.second_moment.allFinite()) return out;
   out.information =
       spread_odometry_information(spread.second_moment, measurement, options_.odometry_sigma_xy,

@@ -69,15 +69,12 @@ Scan2D deskewed(const Scan2D& scan, const Pose2& motion, double interval) {
 
 }  // namespace
 
-// The spread's cells (m): coarse, as the spread costs the more the flatter the fit.
-constexpr double kOpenStepResolution = 0.1;
-
 Pose2 Mapper2D::prior_along_open_direction(const Scan2D& current, const Scan2D& reference,
                                            const Pose2& registered, const Pose2& guess) {
   if (!registered.matrix().allFinite()) return registered;
   const CorrelativeSpread spread =
-      correlative_spread(current, reference, registered, config_.open_step_window, 2.0 * M_PI / 180,
-                         kOpenStepResolution, config_.registration.search_fill_gap,
+      correlative_spread(current, reference, registered, config_.open_step_window, kStepSpreadAngle,
+                         kStepSpreadResolution, config_.registration.search_fill_gap,
                          config_.open_step_margin, Eigen::Vector2d(guess.translation()));
   if (spread.poses == 0 || !spread.second_moment.allFinite()) return registered;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(spread.second_moment);
@@ -90,7 +87,7 @@ Pose2 Mapper2D::prior_along_open_direction(const Scan2D& current, const Scan2D& 
   // cell of the registered pose the scans' answer stands as it is.
   const Eigen::Vector2d open = eigen.eigenvectors().col(1);
   const double along = open.dot(spread.nearest.translation() - registered.translation());
-  if (std::abs(along) < kOpenStepResolution) return registered;
+  if (std::abs(along) < kStepSpreadResolution) return registered;
   const Eigen::Vector2d moved = registered.translation() + along * open;
   const Pose2 shifted = pose2(moved.x(), moved.y(), pose2_angle(registered));
   // Registered again from there for the rotation and the across direction (the spread's axis is

@@ -6,6 +6,7 @@
 // first, so most of the window is dismissed without looking at its cells.
 // register_scans runs it first when Registration2DOptions::search_window is set.
 
+#include <cmath>
 #include <optional>
 
 #include "scanmatch/core/scan2d.hpp"
@@ -51,6 +52,12 @@ struct CorrelativeSpread {
   /// resolution); else, or when nothing counted, `at`.
   Pose2 nearest = Pose2::Identity();
 };
+
+/// How an odometry step's spread is looked at, by Mapper2D (open steps) and LoopClosure2D (its
+/// odometry edges): each translation at its best rotation within +- this (rad), on cells this
+/// coarse (m), as the spread costs the more the flatter the fit.
+inline constexpr double kStepSpreadAngle = 2.0 * M_PI / 180;
+inline constexpr double kStepSpreadResolution = 0.1;
 
 /// Every translation that can come within the margin is scored exactly (blocks of them bounded as
 /// the search bounds them, best first), so a flat fit costs far more than a sharp one: keep the
