@@ -284,6 +284,8 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
         "be negative");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
+  if (!(options.recheck_above >= 0.0))
+    throw Error("loop closure: recheck_above must not be negative");
   if (!(options.verification.min_search_score >= 0.0 &&
         options.verification.min_search_score <= 1.0))
     throw Error("loop closure: min_search_score must be in [0, 1]");
@@ -343,7 +345,23 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
 }
 
 void LoopClosure2D::close_loops(std::size_t keyframe) {
-  if (keyframe <= options_.skip_recent) return;
+  const Pose2 before = graph().pose(keyframe);
+  if (!search_loops(keyframe)) return;
+  optimize();
+  const Pose2 moved = before.inverse() * graph().pose(keyframe);
+  if (moved.translation().norm() + 5.0 * std::abs(pose2_angle(moved)) < options_.recheck_above)
+    return;
+  // The estimate just moved far: the keyframes before this one looked for loops where they were
+  // wrongly placed, beyond the search window of the places they revisit. Look again.
+  bool stale = false;
+  const std::size_t first =
+      keyframe > options_.recheck_keyframes ? keyframe - options_.recheck_keyframes : 0;
+  for (std::size_t j = first; j < keyframe; ++j) stale = search_loops(j) || stale;
+  if (stale) optimize();
+}
+
+bool LoopClosure2D::search_loops(std::size_t keyframe) {
+  if (keyframe <= options_.skip_recent) return false;
   const std::size_t last_candidate = keyframe - options_.skip_recent;  // exclusive
   const Pose2& here = graph().pose(keyframe);
   // Candidates with the relative pose each implies (current keyframe in the candidate's frame).
@@ -380,6 +398,10 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
   }
   bool stale = false;
   for (const auto& [k, initial] : candidates) {
+    const bool linked = std::any_of(
+        graph_.loops().begin(), graph_.loops().end(),
+        [&](const Loop2D& l) { return l.from_keyframe == k && l.to_keyframe == keyframe; });
+    if (linked) continue;
     ++counts_.candidates;
     std::vector<PosedScan2D> neighbours;
     if (options_.submap_keyframes > 0) {
@@ -419,7 +441,7 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
     loop.error = v.error;
     graph_.add_loop(loop, loop_information(v.hessian));
   }
-  if (stale) optimize();
+  return stale;
 }
 
 Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) const {

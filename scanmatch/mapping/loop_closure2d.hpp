@@ -164,6 +164,13 @@ struct LoopClosure2DOptions {
   /// optimization (finish() always runs one). On intel 0.1 ran a quarter of the optimizations
   /// (79 of 329) with the same map, 0.4 fewer still with the same map. 0: after every loop edge.
   double optimize_above = 0.4;
+  /// When an optimization moves the new keyframe by more than this (m at 5 m, as optimize_above),
+  /// the `recheck_keyframes` keyframes before it look for loops again from where it put them:
+  /// they looked while misplaced by as much, often beyond the verification's search window
+  /// (ACES's dead end came back to its mouth 4 m off; only the descriptor's candidates a few scans
+  /// later joined it to the start, and the steps between stayed unheld). 0 keyframes: never.
+  double recheck_above = 1.0;
+  std::size_t recheck_keyframes = 10;
   LoopVerification2DOptions verification;
   PlaceDescriptor2DOptions descriptor;
   PoseGraphConfig graph;
@@ -229,7 +236,12 @@ class LoopClosure2D {
     Pose2 odometry = Pose2::Identity();
     double path = 0.0;  ///< m of odometry travel since the first keyframe
   };
+  /// Searches loops for the new keyframe, optimizes when they disagree with the estimate, and
+  /// searches again for the keyframes before it when that moved the estimate far.
   void close_loops(std::size_t keyframe);
+  /// Verifies `keyframe`'s candidates and adds the accepted loop edges (skipping pairs already
+  /// joined); true when one disagrees enough with the estimate to call for an optimization.
+  bool search_loops(std::size_t keyframe);
   /// A loop edge's information: the verification's Hessian scaled to loop_sigma_xy in its best
   /// direction, the rotation capped at loop_sigma_theta (or the diagonal of both sigmas).
   Eigen::Matrix3d loop_information(const Eigen::Matrix3d& hessian) const;

@@ -439,6 +439,10 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
   v("optimize_above", o.optimize_above, nullptr,
     "Optimize when a loop moves points 5 m away by more than this, m (0: every loop)");
+  v("recheck_above", o.recheck_above, nullptr,
+    "When an optimization moves the new keyframe by more than this (m at 5 m) ...");
+  v("recheck_keyframes", o.recheck_keyframes, nullptr,
+    "... this many keyframes before it look for loops again (0: never)");
   v.nested("verification", o.verification);
   v.nested("descriptor", o.descriptor);
   v.nested("graph", o.graph);
