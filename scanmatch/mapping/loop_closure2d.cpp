@@ -183,6 +183,12 @@ OverlapCheck check_overlap(const Scan2D& from, const OverlapTarget& onto, const 
   return c;
 }
 
+// How far `change` moves points 5 m away, at most, m: the scale optimize_above and recheck_above
+// are given in.
+double moved_at_5m(const Pose2& change) {
+  return change.translation().norm() + 5.0 * std::abs(pose2_angle(change));
+}
+
 Eigen::Matrix3d diagonal_information(double sigma_xy, double sigma_theta) {
   return Eigen::Vector3d(1 / (sigma_xy * sigma_xy), 1 / (sigma_xy * sigma_xy),
                          1 / (sigma_theta * sigma_theta))
@@ -348,9 +354,7 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
   const Pose2 before = graph().pose(keyframe);
   if (!search_loops(keyframe)) return;
   optimize();
-  const Pose2 moved = before.inverse() * graph().pose(keyframe);
-  if (moved.translation().norm() + 5.0 * std::abs(pose2_angle(moved)) < options_.recheck_above)
-    return;
+  if (moved_at_5m(before.inverse() * graph().pose(keyframe)) < options_.recheck_above) return;
   // The estimate just moved far: the keyframes before this one looked for loops where they were
   // wrongly placed, beyond the search window of the places they revisit. Look again.
   bool stale = false;
@@ -428,9 +432,7 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     }
     ++counts_.verified;
     // How far the loop would move the keyframe's points at 5 m from the current estimate.
-    const Pose2 mismatch = estimated.inverse() * v.transform;
-    const double moved = mismatch.translation().norm() + 5.0 * std::abs(pose2_angle(mismatch));
-    if (moved >= options_.optimize_above) stale = true;
+    if (moved_at_5m(estimated.inverse() * v.transform) >= options_.optimize_above) stale = true;
     Loop2D loop;
     loop.from_keyframe = k;
     loop.to_keyframe = keyframe;
@@ -486,11 +488,7 @@ LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
   out.information =
       spread_odometry_information(spread.second_moment, measurement, options_.odometry_sigma_xy,
                                   options_.odometry_sigma_theta, options_.odometry_spread_normal);
-  const double largest =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(spread.second_moment, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .maxCoeff();
-  out.open = largest >= options_.open_step_spread * options_.open_step_spread;
+  out.open = widest_spread(spread).rms >= options_.open_step_spread;
   return out;
 }
 

@@ -1,6 +1,5 @@
 #include "scanmatch/odometry/mapper2d.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 
 #include "scanmatch/core/error.hpp"
@@ -77,15 +76,14 @@ Pose2 Mapper2D::prior_along_open_direction(const Scan2D& current, const Scan2D& 
                          kStepSpreadResolution, config_.registration.search_fill_gap,
                          config_.open_step_margin, Eigen::Vector2d(guess.translation()));
   if (spread.poses == 0 || !spread.second_moment.allFinite()) return registered;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(spread.second_moment);
-  if (eigen.eigenvalues()(1) < config_.open_step_spread * config_.open_step_spread)
-    return registered;
+  const SpreadAxis axis = widest_spread(spread);
+  if (axis.rms < config_.open_step_spread) return registered;
   if ((spread.nearest.translation() - guess.translation()).norm() >
       config_.open_step_prior_distance)
     return registered;
   // Along the open direction only: across it the registration is as good as the scans. Within a
   // cell of the registered pose the scans' answer stands as it is.
-  const Eigen::Vector2d open = eigen.eigenvectors().col(1);
+  const Eigen::Vector2d& open = axis.direction;
   const double along = open.dot(spread.nearest.translation() - registered.translation());
   if (std::abs(along) < kStepSpreadResolution) return registered;
   const Eigen::Vector2d moved = registered.translation() + along * open;

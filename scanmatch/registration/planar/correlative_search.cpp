@@ -1,5 +1,6 @@
 #include "scanmatch/registration/planar/correlative_search.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -457,6 +458,15 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
     }
   if (spread.poses > 0) spread.second_moment /= static_cast<double>(spread.poses);
   return spread;
+}
+
+SpreadAxis widest_spread(const CorrelativeSpread& spread) {
+  SpreadAxis axis;
+  if (spread.poses == 0 || !spread.second_moment.allFinite()) return axis;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(spread.second_moment);
+  axis.direction = eigen.eigenvectors().col(1);
+  axis.rms = std::sqrt(std::max(eigen.eigenvalues()(1), 0.0));
+  return axis;
 }
 
 }  // namespace scanmatch

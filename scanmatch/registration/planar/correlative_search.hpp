@@ -68,6 +68,14 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
                                      double resolution, double fill_gap, double margin,
                                      const std::optional<Eigen::Vector2d>& toward = std::nullopt);
 
+/// The direction the counted translations spread most along (unit; any when none counted) and
+/// their RMS spread along it, m: a step whose spread reaches a few decimetres is open that way.
+struct SpreadAxis {
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();
+  double rms = 0.0;
+};
+SpreadAxis widest_spread(const CorrelativeSpread& spread);
+
 /// The scan's points plus points every `step` (m) between beam neighbours up to `max_gap` apart
 /// that lie on one straight surface (a third neighbour on their line). Two scans sample a wall
 /// seen at a grazing angle at different places, metres apart; scored against the samples alone, a
