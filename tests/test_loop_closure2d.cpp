@@ -97,7 +97,10 @@ TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
   for (const Loop2D& l : loops.loops()) {
     if (l.outlier) continue;
     const Pose2 truth = reference[l.from_scan].inverse() * reference[l.to_scan];
-    const Pose2 error = truth.inverse() * l.relative;
+    Pose2 error = truth.inverse() * l.relative;
+    // A sliding loop holds nothing along its open direction (where the estimate put it).
+    if (l.sliding)
+      error.translation() -= l.slide_direction * l.slide_direction.dot(error.translation());
     EXPECT_LT(error.translation().norm(), 0.15) << l.from_scan << " -> " << l.to_scan;
   }
   // Optimizing after every loop edge (optimize_above 0) runs more often and ends at the same map:
@@ -142,7 +145,8 @@ TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
 TEST(LoopClosure2D, AMatchAlongAPlainCorridorHoldsNothingAlongIt) {
   // A 180-degree scan down a corridor of plain walls (y = +-1.2 m): the match determines the
   // across direction and the heading, nothing along x. The loop edge's information (the
-  // verification's Hessian) must say so, and the verification must not accept it as a loop.
+  // verification's Hessian) must say so; the verification accepts it only as sliding along x,
+  // at the initial guess's x, and not at all without accept_sliding.
   Scan2D scan;
   for (int beam = 0; beam <= 180; ++beam) {
     const double a = (beam - 90) * M_PI / 180;
@@ -150,12 +154,19 @@ TEST(LoopClosure2D, AMatchAlongAPlainCorridorHoldsNothingAlongIt) {
     const double r = 1.2 / std::abs(std::sin(a));
     scan.points.emplace_back(r * std::cos(a), r * std::sin(a));
   }
-  const LoopVerification2D v =
-      verify_loop_2d(scan, scan, pose2(0.3, 0.1, 0.02), LoopVerification2DOptions{});
-  EXPECT_FALSE(v.accepted);
+  LoopVerification2DOptions options;
+  const LoopVerification2D v = verify_loop_2d(scan, scan, pose2(0.3, 0.1, 0.02), options);
   ASSERT_GT(v.hessian(1, 1), 0.0);
   EXPECT_LT(v.hessian(0, 0), 1e-3 * v.hessian(1, 1));
   EXPECT_GT(v.hessian(2, 2), 0.0);
+  ASSERT_TRUE(v.accepted);
+  EXPECT_TRUE(v.sliding);
+  EXPECT_NEAR(std::abs(v.slide_direction.x()), 1.0, 1e-3);
+  EXPECT_NEAR(v.transform.translation().x(), 0.3, 0.02);  // held where the guess put it
+  EXPECT_NEAR(v.transform.translation().y(), 0.0, 0.01);  // across and heading: determined
+  EXPECT_NEAR(pose2_angle(v.transform), 0.0, 0.2 * M_PI / 180);
+  options.accept_sliding = false;
+  EXPECT_FALSE(verify_loop_2d(scan, scan, pose2(0.3, 0.1, 0.02), options).accepted);
 }
 
 TEST(LoopClosure2D, AStepAPlainCorridorLeavesOpenIsHeldLooselyAlongIt) {
@@ -261,7 +272,8 @@ TEST(LoopClosure2D, ATurnOnTheSpotIsHeldByTheWallsItStartedFrom) {
 TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
   // Walls at y = +-1.2 m with a 0.6 m wide, 0.3 m deep door recess every 2 m on both sides, seen
   // by a 180-degree laser (1 deg beams, 30 m). A scan matched 2 m along (one door further) fits as
-  // well as in place: without the shift test it would be accepted; with it, rejected.
+  // well as in place: without the shift test it would be accepted as determined; with it, it is
+  // sliding (or rejected without accept_sliding), fitted again where the anchor puts it along x.
   std::vector<Segment> walls;
   for (double x = -10.0; x < 40.0; x += 2.0)
     for (double side : {-1.0, 1.0}) {
@@ -278,8 +290,24 @@ TEST(LoopClosure2D, ACorridorWithEvenlySpacedDoorsIsAmbiguous) {
   options.max_shifted_fraction = 0.0;
   const LoopVerification2D unchecked = verify_loop_2d(later, here, pose2(0.1, 0.0, 0.0), options);
   EXPECT_TRUE(unchecked.accepted) << unchecked.paired_fraction << " " << unchecked.constraint;
-  EXPECT_FALSE(checked.accepted);
+  EXPECT_FALSE(unchecked.sliding);
+  EXPECT_TRUE(checked.accepted);
+  EXPECT_TRUE(checked.sliding);
   EXPECT_GT(checked.shifted_fraction, 0.8);
+  EXPECT_NEAR(std::abs(checked.slide_direction.x()), 1.0, 0.05);
+  // The truth is 2 m along: anchored 0.15 m from it, the fit finds the right door (where the
+  // scans' sparse far samples no longer coincide, so fewer points pair than at the alias).
+  options.max_shifted_fraction = 0.8;
+  const LoopVerification2D anchored =
+      verify_loop_2d(later, here, pose2(0.1, 0.0, 0.0), options, {}, pose2(1.85, 0.0, 0.0));
+  ASSERT_TRUE(anchored.accepted) << anchored.paired_fraction << " " << anchored.error << " "
+                                 << anchored.free_violations << " "
+                                 << anchored.transform.translation().transpose();
+  EXPECT_TRUE(anchored.sliding);
+  EXPECT_NEAR(anchored.transform.translation().x(), 2.0, 0.05);
+  EXPECT_NEAR(anchored.transform.translation().y(), 0.0, 0.03);
+  options.accept_sliding = false;
+  EXPECT_FALSE(verify_loop_2d(later, here, pose2(0.1, 0.0, 0.0), options).accepted);
 }
 
 TEST(LoopClosure2D, FreeSpaceIsSeenBetweenOneDegreeBeams) {

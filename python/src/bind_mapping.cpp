@@ -22,6 +22,7 @@ py::dict loop_dict(const Loop2D& l) {
   d["relative"] = pose2_to_array(l.relative);
   d["paired_fraction"] = l.paired_fraction;
   d["error"] = l.error;
+  d["sliding"] = l.sliding;
   d["outlier"] = l.outlier;
   return d;
 }
@@ -58,6 +59,7 @@ py::dict counts_dict(const LoopClosure2DCounts& c) {
   d["keyframes"] = c.keyframes;
   d["candidates"] = c.candidates;
   d["verified"] = c.verified;
+  d["sliding"] = c.sliding;
   d["rejected_by_verification"] = c.rejected_by_verification;
   d["rejected_by_estimate"] = c.rejected_by_estimate;
   d["outliers"] = c.outliers;

@@ -189,6 +189,22 @@ double moved_at_5m(const Pose2& change) {
   return change.translation().norm() + 5.0 * std::abs(pose2_angle(change));
 }
 
+// The information with nothing left along the translation `direction` (unit, in the residual's
+// frame) but a trace, 1e-6 of its largest eigenvalue, that keeps it positive definite.
+Eigen::Matrix3d without_direction(const Eigen::Matrix3d& information,
+                                  const Eigen::Vector2d& direction) {
+  Eigen::Vector3d u = Eigen::Vector3d::Zero();
+  u.head<2>() = direction.normalized();
+  const Eigen::Matrix3d keep = Eigen::Matrix3d::Identity() - u * u.transpose();
+  const Eigen::Matrix3d held = keep * information * keep;
+  const double largest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(information, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .maxCoeff();
+  const Eigen::Matrix3d out = held + 1e-6 * largest * u * u.transpose();
+  return 0.5 * (out + out.transpose());
+}
+
 Eigen::Matrix3d diagonal_information(double sigma_xy, double sigma_theta) {
   return Eigen::Vector3d(1 / (sigma_xy * sigma_xy), 1 / (sigma_xy * sigma_xy),
                          1 / (sigma_theta * sigma_theta))
@@ -199,7 +215,9 @@ Eigen::Matrix3d diagonal_information(double sigma_xy, double sigma_theta) {
 
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
                                   const Pose2& initial, const LoopVerification2DOptions& options,
-                                  const std::vector<PosedScan2D>& candidate_neighbours) {
+                                  const std::vector<PosedScan2D>& candidate_neighbours,
+                                  const std::optional<Pose2>& anchor) {
+  const Pose2 slide_anchor = anchor.value_or(initial);
   LoopVerification2D out;
   out.transform = initial;
   const std::size_t min_points = std::max<std::size_t>(options.min_points, 3);
@@ -235,38 +253,71 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
   }
   if (!out.transform.matrix().allFinite()) return out;
   const OverlapTarget reference(reference_scan, views, options.pair_distance, r.search_fill_gap);
-  const OverlapCheck forward =
-      check_overlap(current, reference, out.transform, options.free_margin);
-  const OverlapCheck backward =
-      check_overlap(candidate, OverlapTarget(current, options.pair_distance, r.search_fill_gap),
-                    out.transform.inverse(), options.free_margin);
-  out.paired_fraction = joined ? forward.paired_fraction
-                               : std::min(forward.paired_fraction, backward.paired_fraction);
-  // Against a submap the candidate alone may face away from the current scan and pair nothing:
-  // then the way back has no error or constraint to report, only its free space.
-  const bool backward_paired = !joined || backward.paired_fraction > 0.0;
-  out.error = backward_paired ? std::max(forward.error, backward.error) : forward.error;
-  out.free_violations = std::max(forward.free_violations, backward.free_violations);
-  out.constraint =
-      backward_paired ? std::min(forward.constraint, backward.constraint) : forward.constraint;
-  out.hessian = forward.hessian;
-  out.accepted = out.paired_fraction >= options.min_paired_fraction &&
-                 out.error <= options.max_error &&
-                 out.free_violations <= options.max_free_violations &&
-                 out.constraint >= options.min_constraint;
-  if (out.accepted && options.max_shifted_fraction > 0.0) {
+  const OverlapTarget current_target(current, options.pair_distance, r.search_fill_gap);
+  // Fills out's checks at out.transform; returns the forward paired share and whether it fits.
+  const auto assess = [&]() {
+    const OverlapCheck forward =
+        check_overlap(current, reference, out.transform, options.free_margin);
+    const OverlapCheck backward =
+        check_overlap(candidate, current_target, out.transform.inverse(), options.free_margin);
+    out.paired_fraction = joined ? forward.paired_fraction
+                                 : std::min(forward.paired_fraction, backward.paired_fraction);
+    // Against a submap the candidate alone may face away from the current scan and pair nothing:
+    // then the way back has no error or constraint to report, only its free space.
+    const bool backward_paired = !joined || backward.paired_fraction > 0.0;
+    out.error = backward_paired ? std::max(forward.error, backward.error) : forward.error;
+    out.free_violations = std::max(forward.free_violations, backward.free_violations);
+    out.constraint =
+        backward_paired ? std::min(forward.constraint, backward.constraint) : forward.constraint;
+    out.hessian = forward.hessian;
+    const bool fits = out.paired_fraction >= options.min_paired_fraction &&
+                      out.error <= options.max_error &&
+                      out.free_violations <= options.max_free_violations;
+    return std::make_pair(forward.paired_fraction, fits);
+  };
+  const auto [forward_paired, fits] = assess();
+  if (!fits) return out;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(out.hessian.topLeftCorner<2, 2>());
+  const Eigen::Vector2d weak = eigen.eigenvectors().col(0);
+  bool determined = out.constraint >= options.min_constraint;
+  if (determined && options.max_shifted_fraction > 0.0) {
     // Slid along the direction the match determines least, does the scan fit nearly as well?
-    // Then the place is ambiguous there (a corridor, doors at even spacing): not a loop.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(out.hessian.topLeftCorner<2, 2>());
-    const Eigen::Vector2d weak = eigen.eigenvectors().col(0);
+    // Then the place is ambiguous there (a corridor, doors at even spacing).
     for (double shift : {-3.0, -2.0, -1.0, 1.0, 2.0, 3.0}) {
       const Pose2 shifted = out.transform * pose2(shift * weak.x(), shift * weak.y(), 0.0);
       const OverlapCheck c = check_overlap(current, reference, shifted, options.free_margin);
-      out.shifted_fraction = std::max(out.shifted_fraction,
-                                      c.paired_fraction / std::max(forward.paired_fraction, 1e-9));
+      out.shifted_fraction =
+          std::max(out.shifted_fraction, c.paired_fraction / std::max(forward_paired, 1e-9));
     }
-    out.accepted = out.shifted_fraction <= options.max_shifted_fraction;
+    determined = out.shifted_fraction <= options.max_shifted_fraction;
   }
+  if (determined || !options.accept_sliding) {
+    out.accepted = determined;
+    return out;
+  }
+  // Along the open direction the search stopped at any of the places that fit, perhaps a door
+  // away; its weak direction is a little off the corridor's, so that slide leaks across. Fitted
+  // again from the anchor's position along it, the match holds where the estimate puts it. The
+  // first fit showed the same place; there the scans must still fit closely and not see into
+  // each other's free space (the paired share may drop: sparse far samples pair only where the
+  // two scans sampled alike, as at the first fit's alias).
+  const Eigen::Vector2d axis = out.transform.rotation() * weak;
+  Pose2 anchored = out.transform;
+  anchored.translation() += axis * axis.dot(slide_anchor.translation() - anchored.translation());
+  try {
+    out.transform = refine_searched(current, reference_scan, r, anchored).transform;
+  } catch (const Error&) {
+    return out;
+  }
+  if (!out.transform.matrix().allFinite()) return out;
+  const double shown_same_place = out.paired_fraction;
+  assess();
+  out.paired_fraction = shown_same_place;
+  if (out.error > options.max_error || out.free_violations > options.max_free_violations)
+    return out;
+  out.accepted = true;
+  out.sliding = true;
+  out.slide_direction = weak;
   return out;
 }
 
@@ -416,32 +467,39 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
           neighbours.push_back(
               {&keyframes_[j].points, graph().pose(k).inverse() * graph().pose(j)});
     }
-    const LoopVerification2D v = verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points,
-                                                initial, options_.verification, neighbours);
+    const Pose2 estimated = graph().pose(k).inverse() * here;
+    const LoopVerification2D v =
+        verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points, initial,
+                       options_.verification, neighbours, estimated);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;
     }
-    const Pose2 estimated = graph().pose(k).inverse() * here;
+    const Pose2& measured = v.transform;
     const double allowed =
         options_.max_correction +
         options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
-    if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
+    if ((estimated.translation() - measured.translation()).norm() > allowed) {
       ++counts_.rejected_by_estimate;
       continue;
     }
     ++counts_.verified;
+    if (v.sliding) ++counts_.sliding;
     // How far the loop would move the keyframe's points at 5 m from the current estimate.
-    if (moved_at_5m(estimated.inverse() * v.transform) >= options_.optimize_above) stale = true;
+    if (moved_at_5m(estimated.inverse() * measured) >= options_.optimize_above) stale = true;
     Loop2D loop;
     loop.from_keyframe = k;
     loop.to_keyframe = keyframe;
     loop.from_scan = keyframes_[k].scan;
     loop.to_scan = keyframes_[keyframe].scan;
-    loop.relative = v.transform;
+    loop.relative = measured;
     loop.paired_fraction = v.paired_fraction;
     loop.error = v.error;
-    graph_.add_loop(loop, loop_information(v.hessian));
+    loop.sliding = v.sliding;
+    loop.slide_direction = v.slide_direction;
+    Eigen::Matrix3d information = loop_information(v.hessian);
+    if (v.sliding) information = without_direction(information, v.slide_direction);
+    graph_.add_loop(loop, information);
   }
   return stale;
 }

@@ -14,6 +14,7 @@
 // (PoseGraphConfig) catch what still slips through.
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,12 @@ struct LoopVerification2DOptions {
   /// keeps more than this share of its paired points (an ambiguous place: a corridor with doors at
   /// even spacing). 0: not checked.
   double max_shifted_fraction = 0.8;
+  /// A match that fits (paired share, error, free space) but leaves one translation direction
+  /// open (a weak constraint, or the shift test above) is accepted as sliding: its loop edge holds
+  /// the heading and the translation across that direction only. A corridor revisited holds
+  /// little else, and without such edges a whole traversal can sit 0.2 m across from the
+  /// walls it saw before (ACES's diagonal corridor, scans 264-278). false: rejected instead.
+  bool accept_sliding = true;
 };
 
 /// The result of verifying one candidate: `transform` maps current points into the candidate's
@@ -78,6 +85,11 @@ struct LoopVerification2D {
   Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
   /// The largest share of the paired points kept when slid along the weak direction (when checked).
   double shifted_fraction = 0.0;
+  /// Accepted as sliding (accept_sliding): the translation along `slide_direction` (a unit vector
+  /// in the current scan's frame, the Hessian's weakest translation) is undetermined. The checks
+  /// above are then those at the anchored fit, but for paired_fraction: the first fit's.
+  bool sliding = false;
+  Eigen::Vector2d slide_direction = Eigen::Vector2d::Zero();
 };
 
 /// A scan and the pose it was taken from, in the frame of the scan it is joined to.
@@ -92,10 +104,13 @@ struct PosedScan2D {
 /// scan is registered onto and paired against the candidate joined by them, whose wider view a
 /// 180-degree scan revisiting a place from elsewhere overlaps; the way back (candidate onto
 /// current) then checks only the error and the free space, not the paired share. The free space
-/// is what each of those scans saw from where it was taken.
+/// is what each of those scans saw from where it was taken. A sliding match (accept_sliding) is
+/// fitted again from `anchor`'s position along its open direction (default: `initial`'s), and
+/// must fit there too.
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
                                   const Pose2& initial, const LoopVerification2DOptions& options,
-                                  const std::vector<PosedScan2D>& candidate_neighbours = {});
+                                  const std::vector<PosedScan2D>& candidate_neighbours = {},
+                                  const std::optional<Pose2>& anchor = std::nullopt);
 
 struct LoopClosure2DOptions {
   /// A new keyframe once the odometry has moved this far from the last one (m or rad). Every
@@ -182,6 +197,10 @@ struct Loop2D {
   std::size_t from_scan = 0, to_scan = 0;          ///< their indices among all added scans
   Pose2 relative = Pose2::Identity();              ///< to in the frame of from
   double paired_fraction = 0.0, error = 0.0;
+  /// Holds only the heading and the translation across `slide_direction` (in the newer keyframe's
+  /// frame); `relative` then takes the estimate's position along it.
+  bool sliding = false;
+  Eigen::Vector2d slide_direction = Eigen::Vector2d::Zero();
   bool outlier = false;  ///< judged an outlier by the graph's last optimize()
 };
 
@@ -189,6 +208,7 @@ struct LoopClosure2DCounts {
   std::size_t keyframes = 0;
   std::size_t candidates = 0;  ///< candidate pairs proposed (after merging both sources)
   std::size_t verified = 0;    ///< candidates that passed the geometric check (loop edges added)
+  std::size_t sliding = 0;     ///< of those, accepted as sliding (LoopVerification2D::sliding)
   std::size_t rejected_by_verification = 0;
   /// Verified but too far from the current estimate (max_correction): not added.
   std::size_t rejected_by_estimate = 0;

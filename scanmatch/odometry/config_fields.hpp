@@ -326,6 +326,8 @@ void describe(LoopVerification2DOptions& o, Visitor& v) {
   v("min_points", o.min_points, nullptr, "Points each scan needs to be verified");
   v("max_shifted_fraction", o.max_shifted_fraction, nullptr,
     "reject when slid 1-3 m along the weak direction keeps more of the pairs (0: off)");
+  v("accept_sliding", o.accept_sliding, nullptr,
+    "Accept a fitting match that leaves one direction open, holding the rest only");
 }
 
 template <typename Visitor>

@@ -244,6 +244,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
                             {"theta", pose2_angle(l.relative)},
                             {"paired_fraction", l.paired_fraction},
                             {"error_m", l.error}});
+      if (l.sliding)
+        loops_json.back()["slide_direction"] = {l.slide_direction.x(), l.slide_direction.y()};
     }
     write_file_atomic(file("loops.json"), loops_json.dump(2) + "\n");
   }
@@ -340,6 +342,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     j["loop_closure"] = {{"keyframes", c.keyframes},
                          {"candidates", c.candidates},
                          {"verified", c.verified},
+                         {"sliding", c.sliding},
                          {"rejected_by_verification", c.rejected_by_verification},
                          {"rejected_by_estimate", c.rejected_by_estimate},
                          {"rejected_as_outliers", c.outliers},
