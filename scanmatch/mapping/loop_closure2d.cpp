@@ -475,24 +475,23 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
       ++counts_.rejected_by_verification;
       continue;
     }
-    const Pose2& measured = v.transform;
     const double allowed =
         options_.max_correction +
         options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
-    if ((estimated.translation() - measured.translation()).norm() > allowed) {
+    if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
       ++counts_.rejected_by_estimate;
       continue;
     }
     ++counts_.verified;
     if (v.sliding) ++counts_.sliding;
     // How far the loop would move the keyframe's points at 5 m from the current estimate.
-    if (moved_at_5m(estimated.inverse() * measured) >= options_.optimize_above) stale = true;
+    if (moved_at_5m(estimated.inverse() * v.transform) >= options_.optimize_above) stale = true;
     Loop2D loop;
     loop.from_keyframe = k;
     loop.to_keyframe = keyframe;
     loop.from_scan = keyframes_[k].scan;
     loop.to_scan = keyframes_[keyframe].scan;
-    loop.relative = measured;
+    loop.relative = v.transform;
     loop.paired_fraction = v.paired_fraction;
     loop.error = v.error;
     loop.sliding = v.sliding;

@@ -86,8 +86,9 @@ struct LoopVerification2D {
   /// The largest share of the paired points kept when slid along the weak direction (when checked).
   double shifted_fraction = 0.0;
   /// Accepted as sliding (accept_sliding): the translation along `slide_direction` (a unit vector
-  /// in the current scan's frame, the Hessian's weakest translation) is undetermined. The checks
-  /// above are then those at the anchored fit, but for paired_fraction: the first fit's.
+  /// in the current scan's frame, the first fit's weakest translation) is undetermined. The checks
+  /// and the Hessian above are then those at the anchored fit, but for paired_fraction: the first
+  /// fit's.
   bool sliding = false;
   Eigen::Vector2d slide_direction = Eigen::Vector2d::Zero();
 };
