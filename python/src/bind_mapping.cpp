@@ -23,6 +23,8 @@ py::dict loop_dict(const Loop2D& l) {
   d["paired_fraction"] = l.paired_fraction;
   d["error"] = l.error;
   d["sliding"] = l.sliding;
+  // Unit vector in the to-scan's frame along which a sliding loop holds nothing (zero otherwise).
+  d["slide_direction"] = py::make_tuple(l.slide_direction.x(), l.slide_direction.y());
   d["outlier"] = l.outlier;
   return d;
 }
