@@ -254,7 +254,12 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
   if (!out.transform.matrix().allFinite()) return out;
   const OverlapTarget reference(reference_scan, views, options.pair_distance, r.search_fill_gap);
   const OverlapTarget current_target(current, options.pair_distance, r.search_fill_gap);
-  // Fills out's checks at out.transform; returns the forward paired share and whether it fits.
+  // Fills out's checks at out.transform.
+  struct Assessment {
+    double forward_paired;  // the current scan's share paired onto the reference
+    bool close;             // small error, nothing in the other's free space
+    bool paired;            // enough of the points paired
+  };
   const auto assess = [&]() {
     const OverlapCheck forward =
         check_overlap(current, reference, out.transform, options.free_margin);
@@ -270,13 +275,14 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
     out.constraint =
         backward_paired ? std::min(forward.constraint, backward.constraint) : forward.constraint;
     out.hessian = forward.hessian;
-    const bool fits = out.paired_fraction >= options.min_paired_fraction &&
-                      out.error <= options.max_error &&
-                      out.free_violations <= options.max_free_violations;
-    return std::make_pair(forward.paired_fraction, fits);
+    return Assessment{
+        forward.paired_fraction,
+        out.error <= options.max_error && out.free_violations <= options.max_free_violations,
+        out.paired_fraction >= options.min_paired_fraction};
   };
-  const auto [forward_paired, fits] = assess();
-  if (!fits) return out;
+  const Assessment first = assess();
+  if (!first.close || !first.paired) return out;
+  const double forward_paired = first.forward_paired;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(out.hessian.topLeftCorner<2, 2>());
   const Eigen::Vector2d weak = eigen.eigenvectors().col(0);
   bool determined = out.constraint >= options.min_constraint;
@@ -311,10 +317,9 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
   }
   if (!out.transform.matrix().allFinite()) return out;
   const double shown_same_place = out.paired_fraction;
-  assess();
+  const bool close = assess().close;
   out.paired_fraction = shown_same_place;
-  if (out.error > options.max_error || out.free_violations > options.max_free_violations)
-    return out;
+  if (!close) return out;
   out.accepted = true;
   out.sliding = true;
   out.slide_direction = weak;
