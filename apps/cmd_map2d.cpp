@@ -154,6 +154,21 @@ void add_map2d_command(CLI::App& app) {
                    s.map_agreement_odometry >= 0
                        ? fmt::format(" (odometry map {:.3f})", s.map_agreement_odometry)
                        : "");
+      if (s.consistency_odometry.revisited > 0) {
+        const RevisitConsistency2D& c =
+            s.loop_closure ? s.consistency_optimized : s.consistency_odometry;
+        std::string others;
+        if (s.loop_closure)
+          others += fmt::format("odometry {:.1f} cm", 100 * s.consistency_odometry.mean);
+        if (s.consistency_reference.revisited > 0)
+          others += fmt::format("{}reference poses {:.1f} cm", others.empty() ? "" : ", ",
+                                100 * s.consistency_reference.mean);
+        fmt::print(
+            "revisit consistency (no reference needed): walls of revisits {:.1f} cm apart, mean "
+            "over {:.0f} % of the points{}\n",
+            100 * c.mean, 100.0 * static_cast<double>(c.revisited) / static_cast<double>(c.points),
+            others.empty() ? "" : " (" + others + ")");
+      }
       if (!s.map_error.empty()) fmt::print("no map written: {}\n", s.map_error);
       fmt::print("run folder: {}\n", c->out);
     }

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -514,6 +515,46 @@ TEST(Metrics2D, AllPairsRelativeErrorOfAKnownDrift) {
   EXPECT_THROW(all_pairs_relative_error_2d(reference, {}), Error);
 }
 
+TEST(Metrics2D, RevisitConsistencyMeasuresHowFarApartRevisitsWallsLie) {
+  // 30 noiseless scans of the room along a slow drive and turn; with a gap of 20 scans, scans
+  // 0-9 and 20-29 see each other and 10-19 have no other visit: two thirds of the points count.
+  std::vector<Scan2D> scans;
+  std::vector<Pose2> truth;
+  for (int i = 0; i < 30; ++i) {
+    truth.push_back(pose2(1.5 + 0.1 * i, 1.5 + 0.03 * i, 0.02 * i));
+    scans.push_back(room_scan(truth.back()));
+  }
+  const RevisitConsistency2D exact = revisit_consistency_2d(scans, truth);
+  EXPECT_EQ(exact.points, 30u * 360u);
+  // A few points behind the block's corner are seen from one visit only.
+  const double revisited_share =
+      static_cast<double>(exact.revisited) / static_cast<double>(exact.points);
+  EXPECT_LE(revisited_share, 2.0 / 3 + 1e-12);
+  EXPECT_GT(revisited_share, 0.65);
+  // On the walls the surfaces coincide; only at corners the neighbour's segment turns.
+  EXPECT_LT(exact.mean, 0.005);
+  EXPECT_LT(exact.median, 1e-6);
+  // The second half placed 4 cm off in x and 3 cm in y: its walls x = 0 and x = 6 lie 4 cm
+  // from the first half's, y = 0 and y = 4 3 cm.
+  std::vector<Pose2> moved = truth;
+  for (int i = 15; i < 30; ++i) moved[i] = pose2(0.04, -0.03, 0.0) * truth[i];
+  const RevisitConsistency2D off = revisit_consistency_2d(scans, moved);
+  EXPECT_GT(off.median, 0.029);
+  EXPECT_LT(off.median, 0.041);
+  EXPECT_GT(off.mean, 0.028);
+  EXPECT_LT(off.mean, 0.045);
+  EXPECT_LE(off.p90, 0.041);
+  // Within 2 cm only points at corners pair; a gap past the sequence leaves no revisit.
+  EXPECT_LT(revisit_consistency_2d(scans, moved, 20, 0.02).revisited, exact.revisited / 100);
+  EXPECT_EQ(revisit_consistency_2d(scans, truth, 30).revisited, 0u);
+  // Every n-th point is looked at when there are more than max_queries.
+  EXPECT_EQ(revisit_consistency_2d(scans, truth, 20, 0.5, 1000).points, 982u);
+  EXPECT_EQ(revisit_consistency_2d({}, {}).points, 0u);
+  EXPECT_THROW(revisit_consistency_2d(scans, {}), Error);
+  EXPECT_THROW(revisit_consistency_2d(scans, truth, 0), Error);
+  EXPECT_THROW(revisit_consistency_2d(scans, truth, 20, 0.0), Error);
+}
+
 TEST(Map2D, WideSearchFindsATurnBeyondTheSearchAngle) {
   // A 75-degree turn between two scans, as 1 Hz logs turn corners (ACES: up to 78), searched
   // +-45 degrees from the identity: only the wide second search can find it.
@@ -635,6 +676,23 @@ TEST(Map2D, SimulatedRoomsGiveAMapAlongTheTrueWalls) {
   ASSERT_EQ(s.scans, 100u);
   EXPECT_EQ(s.bridged, 0u);
   EXPECT_LT(s.one_step.mean_translation, 0.02);
+  // Scans 20 apart see the same walls: with the true poses they agree to the range noise (1 % of
+  // at most 4 m); summary.json gives the odometry's and the true poses' consistency.
+  EXPECT_GT(s.consistency_reference.revisited, s.consistency_reference.points / 2);
+  EXPECT_LT(s.consistency_reference.median, 0.01);
+  EXPECT_GT(s.consistency_odometry.revisited, s.consistency_odometry.points / 2);
+  EXPECT_LT(s.consistency_odometry.median, 0.03);
+  {
+    std::ifstream in(dir.file("summary.json"));
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_NEAR(j.at("revisit_consistency").at("median_m").get<double>(),
+                s.consistency_odometry.median, 1e-12);
+    EXPECT_NEAR(j.at("revisit_consistency_reference").at("mean_m").get<double>(),
+                s.consistency_reference.mean, 1e-12);
+    EXPECT_FALSE(j.contains("revisit_consistency_odometry"));  // without loop closure
+  }
+  std::printf("revisit consistency, median: odometry %.4f m, true poses %.4f m\n",
+              s.consistency_odometry.median, s.consistency_reference.median);
   // Occupied cells lie on the true walls: the grid's world is the first scan's laser frame.
   sim::SimOptions so;
   so.preset = "room-2d";

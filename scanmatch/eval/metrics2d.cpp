@@ -1,7 +1,13 @@
 #include "scanmatch/eval/metrics2d.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
@@ -118,6 +124,93 @@ AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference
   r.mean = sum / static_cast<double>(r.poses);
   r.rmse = std::sqrt(sum_squared / static_cast<double>(r.poses));
   return r;
+}
+
+RevisitConsistency2D revisit_consistency_2d(const std::vector<Scan2D>& scans,
+                                            const std::vector<Pose2>& poses,
+                                            std::size_t revisit_gap, double max_distance,
+                                            std::size_t max_queries) {
+  if (scans.size() != poses.size())
+    throw Error("revisit consistency: " + std::to_string(poses.size()) + " poses for " +
+                std::to_string(scans.size()) + " scans");
+  if (revisit_gap == 0) throw Error("revisit consistency: the revisit gap must be at least 1");
+  if (!(max_distance > 0.0))
+    throw Error("revisit consistency: the maximum distance must be positive");
+  std::vector<Eigen::Vector2d> world;
+  std::vector<std::size_t> scan_of;
+  for (std::size_t i = 0; i < scans.size(); ++i)
+    for (const Eigen::Vector2d& p : scans[i].points) {
+      world.push_back(poses[i] * p);
+      scan_of.push_back(i);
+    }
+  RevisitConsistency2D out;
+  if (world.empty()) return out;
+  const std::size_t stride = std::max<std::size_t>(
+      1, (world.size() + max_queries - 1) / std::max<std::size_t>(max_queries, 1));
+  const std::size_t queries = (world.size() + stride - 1) / stride;
+  // Cells as wide as the distance: the nearest other visit's point within it lies in the query's
+  // cell or one of the eight around. (A k-d tree's nearest points are mostly the query's own
+  // visit where the sensor moved slowly.)
+  const auto cell_of = [&](const Eigen::Vector2d& p) {
+    return Eigen::Vector2i(static_cast<int>(std::floor(p.x() / max_distance)),
+                           static_cast<int>(std::floor(p.y() / max_distance)));
+  };
+  const auto key = [](const Eigen::Vector2i& c) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x())) << 32) |
+           static_cast<std::uint32_t>(c.y());
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
+  for (std::size_t j = 0; j < world.size(); ++j) cells[key(cell_of(world[j]))].push_back(j);
+  // A wall's neighbour on the surface: the next point of its scan, unless a gap lies between.
+  constexpr double kMaxSegment = 0.3;
+  const auto surface_distance = [&](std::size_t i, std::size_t j, double squared) {
+    const std::size_t b = scan_of[j];
+    const std::size_t next = j + 1 < world.size() && scan_of[j + 1] == b ? j + 1 : j - 1;
+    if (next < world.size() && scan_of[next] == b) {
+      const Eigen::Vector2d along = world[next] - world[j];
+      const double length = along.norm();
+      if (length > 0.0 && length < kMaxSegment)
+        return std::abs(Eigen::Vector2d(-along.y(), along.x()).dot(world[i] - world[j])) / length;
+    }
+    return std::sqrt(squared);
+  };
+  std::vector<double> distance(queries, std::numeric_limits<double>::quiet_NaN());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries), [&](const auto& range) {
+    for (std::size_t q = range.begin(); q < range.end(); ++q) {
+      const std::size_t i = q * stride;
+      const Eigen::Vector2i c = cell_of(world[i]);
+      double best = max_distance * max_distance;
+      std::size_t nearest = world.size();
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy) {
+          const auto it = cells.find(key(c + Eigen::Vector2i(dx, dy)));
+          if (it == cells.end()) continue;
+          for (const std::size_t j : it->second) {
+            const std::size_t a = scan_of[i], b = scan_of[j];
+            if ((a > b ? a - b : b - a) < revisit_gap) continue;
+            const double d = (world[j] - world[i]).squaredNorm();
+            if (d <= best) {
+              best = d;
+              nearest = j;
+            }
+          }
+        }
+      if (nearest < world.size())
+        distance[q] = std::min(surface_distance(i, nearest, best), max_distance);
+    }
+  });
+  out.points = queries;
+  std::vector<double> revisited;
+  for (double d : distance)
+    if (std::isfinite(d)) revisited.push_back(d);
+  out.revisited = revisited.size();
+  if (revisited.empty()) return out;
+  out.mean = mean_of(revisited);
+  out.median = median_of(revisited);
+  std::sort(revisited.begin(), revisited.end());
+  out.p90 = revisited[std::min(
+      revisited.size() - 1, static_cast<std::size_t>(0.9 * static_cast<double>(revisited.size())))];
+  return out;
 }
 
 }  // namespace scanmatch

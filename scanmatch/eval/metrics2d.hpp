@@ -44,4 +44,23 @@ struct AbsoluteError2D {
 AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference,
                                              const std::vector<Pose2>& estimate);
 
+/// How well the scans agree where the sensor came back, measured without a reference: a wall
+/// seen twice lies double in the map by as much as the two visits disagree. Each point (or every
+/// n-th, to look at most at `max_queries`) is compared with the nearest point of another visit,
+/// a scan at least `revisit_gap` scans away: its distance to the line through that point and its
+/// beam neighbour (the surface there), capped at `max_distance`. Points with no other visit's
+/// point within `max_distance` do not count. The poses' own noise sets a floor (about 2-3 cm on
+/// the Radish logs' corrected poses).
+struct RevisitConsistency2D {
+  std::size_t points = 0;     ///< points looked at
+  std::size_t revisited = 0;  ///< of those, with another visit's point within max_distance
+  double mean = 0, median = 0, p90 = 0;  ///< m, over the revisited points
+};
+/// `poses[i]` is the pose of `scans[i]` (points in the laser frame). Throws Error when the sizes
+/// differ, the gap is 0 or the distance not positive.
+RevisitConsistency2D revisit_consistency_2d(const std::vector<Scan2D>& scans,
+                                            const std::vector<Pose2>& poses,
+                                            std::size_t revisit_gap = 20, double max_distance = 0.5,
+                                            std::size_t max_queries = 200000);
+
 }  // namespace scanmatch

@@ -42,6 +42,15 @@ nlohmann::ordered_json error_json(const RelativeError2D& e) {
           {"failure_rate", e.failure_rate}};
 }
 
+nlohmann::ordered_json consistency_json(const RevisitConsistency2D& c) {
+  return {{"points", c.points},
+          {"revisited_share",
+           c.points > 0 ? static_cast<double>(c.revisited) / static_cast<double>(c.points) : 0.0},
+          {"mean_m", c.mean},
+          {"median_m", c.median},
+          {"p90_m", c.p90}};
+}
+
 nlohmann::ordered_json ate_json(const AbsoluteError2D& e) {
   return {{"poses", e.poses}, {"rmse_m", e.rmse}, {"mean_m", e.mean}, {"max_m", e.max}};
 }
@@ -139,7 +148,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       [&](LoopInput& in) { loop_closure->add_scan(in.scan, in.pose); }, kLoopQueueScans,
       options.loop_closure && options.loop_closure_thread);
   const Stopwatch run_time;
-  // The registered scans, kept to rebuild the map from the optimized poses.
+  // The registered scans, kept to rebuild the map from the optimized poses and to measure how
+  // well revisits agree.
   std::vector<Scan2D> kept_scans;
   std::vector<Pose2> estimate, reference;
   Trajectory reference_trajectory;
@@ -176,13 +186,11 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       }
     };
     insert(grid, summary.map_error, pose);
-    if (loop_closure) {
-      loop_worker.push({mapper.last_scan(), pose});
-      Scan2D kept = mapper.last_scan();
-      kept.misses = scan.misses;
-      kept.times.clear();
-      kept_scans.push_back(std::move(kept));
-    }
+    if (loop_closure) loop_worker.push({mapper.last_scan(), pose});
+    Scan2D kept = mapper.last_scan();
+    kept.misses = scan.misses;
+    kept.times.clear();
+    kept_scans.push_back(std::move(kept));
     if (options.reference_map && input.has_reference)
       insert(reference_grid, summary.reference_map_error,
              reference.front().inverse() * reference.back());
@@ -288,6 +296,14 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       summary.map_error = optimized_map_error;
     }
   }
+  // Needs no reference: how far apart the walls of revisits lie.
+  if (summary.scans > 0) {
+    summary.consistency_odometry = revisit_consistency_2d(kept_scans, estimate);
+    if (loop_closure && optimized.size() == kept_scans.size())
+      summary.consistency_optimized = revisit_consistency_2d(kept_scans, optimized);
+    if (input.has_reference)
+      summary.consistency_reference = revisit_consistency_2d(kept_scans, reference);
+  }
   const Registration2DOptions& r = options.mapper.registration;
   nlohmann::ordered_json j;
   j["input"] = input.description;
@@ -337,6 +353,14 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   if (summary.map_agreement >= 0) j["map_agreement"] = summary.map_agreement;
   if (summary.map_agreement_odometry >= 0)
     j["map_agreement_odometry"] = summary.map_agreement_odometry;
+  if (summary.consistency_odometry.points > 0) {
+    j["revisit_consistency"] = consistency_json(
+        summary.loop_closure ? summary.consistency_optimized : summary.consistency_odometry);
+    if (summary.loop_closure)
+      j["revisit_consistency_odometry"] = consistency_json(summary.consistency_odometry);
+    if (summary.consistency_reference.points > 0)
+      j["revisit_consistency_reference"] = consistency_json(summary.consistency_reference);
+  }
   if (summary.loop_closure) {
     const LoopClosure2DCounts& c = summary.loops;
     j["loop_closure"] = {{"keyframes", c.keyframes},

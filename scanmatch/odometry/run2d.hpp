@@ -74,6 +74,10 @@ struct Map2DSummary {
   /// (negative: not computed; needs reference_map), for map.* and (with loop closure) the
   /// odometry's map.
   double map_agreement = -1, map_agreement_odometry = -1;
+  /// How far apart revisits' walls lie (revisit_consistency_2d; needs no reference): for the
+  /// optimized poses with loop closure (else unset), the odometry's and (with a reference) the
+  /// reference poses'.
+  RevisitConsistency2D consistency_optimized, consistency_odometry, consistency_reference;
   /// Why map.* (or map_reference.*) was not written, e.g. a trajectory too large for the grid.
   std::string map_error, reference_map_error;
 };
