@@ -550,6 +550,11 @@ TEST(Metrics2D, RevisitConsistencyMeasuresHowFarApartRevisitsWallsLie) {
   // Every n-th point is looked at when there are more than max_queries.
   EXPECT_EQ(revisit_consistency_2d(scans, truth, 20, 0.5, 1000).points, 982u);
   EXPECT_EQ(revisit_consistency_2d({}, {}).points, 0u);
+  // A diverged pose's points are left out, not crashed on.
+  std::vector<Pose2> diverged = truth;
+  diverged[25] = pose2(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
+  diverged[26] = pose2(1e300, 0.0, 0.0);
+  EXPECT_EQ(revisit_consistency_2d(scans, diverged).points, 28u * 360u);
   EXPECT_THROW(revisit_consistency_2d(scans, {}), Error);
   EXPECT_THROW(revisit_consistency_2d(scans, truth, 0), Error);
   EXPECT_THROW(revisit_consistency_2d(scans, truth, 20, 0.0), Error);

@@ -136,17 +136,21 @@ RevisitConsistency2D revisit_consistency_2d(const std::vector<Scan2D>& scans,
   if (revisit_gap == 0) throw Error("revisit consistency: the revisit gap must be at least 1");
   if (!(max_distance > 0.0))
     throw Error("revisit consistency: the maximum distance must be positive");
+  constexpr double kFarthestCell = 1e9;  // keeps cell indices inside int
   std::vector<Eigen::Vector2d> world;
   std::vector<std::size_t> scan_of;
   for (std::size_t i = 0; i < scans.size(); ++i)
     for (const Eigen::Vector2d& p : scans[i].points) {
-      world.push_back(poses[i] * p);
+      // A run that diverged can put points anywhere: those beyond any map are left out.
+      const Eigen::Vector2d w = poses[i] * p;
+      if (!w.allFinite() || w.cwiseAbs().maxCoeff() / max_distance > kFarthestCell) continue;
+      world.push_back(w);
       scan_of.push_back(i);
     }
   RevisitConsistency2D out;
   if (world.empty()) return out;
-  const std::size_t stride = std::max<std::size_t>(
-      1, (world.size() + max_queries - 1) / std::max<std::size_t>(max_queries, 1));
+  const std::size_t limit = std::max<std::size_t>(max_queries, 1);
+  const std::size_t stride = std::max<std::size_t>(1, (world.size() + limit - 1) / limit);
   const std::size_t queries = (world.size() + stride - 1) / stride;
   // Cells as wide as the distance: the nearest other visit's point within it lies in the query's
   // cell or one of the eight around. (A k-d tree's nearest points are mostly the query's own

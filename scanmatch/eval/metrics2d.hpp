@@ -49,8 +49,9 @@ AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference
 /// n-th, to look at most at `max_queries`) is compared with the nearest point of another visit,
 /// a scan at least `revisit_gap` scans away: its distance to the line through that point and its
 /// beam neighbour (the surface there), capped at `max_distance`. Points with no other visit's
-/// point within `max_distance` do not count. The poses' own noise sets a floor (about 2-3 cm on
-/// the Radish logs' corrected poses).
+/// point within `max_distance` do not count, nor points not finite or 10^9 times max_distance
+/// away (a diverged run). The poses' own noise and sparse far samples set a floor (means of
+/// 2-7 cm with the Radish logs' corrected poses).
 struct RevisitConsistency2D {
   std::size_t points = 0;     ///< points looked at
   std::size_t revisited = 0;  ///< of those, with another visit's point within max_distance
