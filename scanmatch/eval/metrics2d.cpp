@@ -11,6 +11,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
+#include "scanmatch/registration/planar/line_fitting.hpp"
 
 namespace scanmatch {
 
@@ -138,14 +139,15 @@ RevisitConsistency2D revisit_consistency_2d(const std::vector<Scan2D>& scans,
     throw Error("revisit consistency: the maximum distance must be positive");
   constexpr double kFarthestCell = 1e9;  // keeps cell indices inside int
   std::vector<Eigen::Vector2d> world;
-  std::vector<std::size_t> scan_of;
+  std::vector<std::size_t> scan_of, index_in_scan;
   for (std::size_t i = 0; i < scans.size(); ++i)
-    for (const Eigen::Vector2d& p : scans[i].points) {
+    for (std::size_t k = 0; k < scans[i].points.size(); ++k) {
       // A run that diverged can put points anywhere: those beyond any map are left out.
-      const Eigen::Vector2d w = poses[i] * p;
+      const Eigen::Vector2d w = poses[i] * scans[i].points[k];
       if (!w.allFinite() || w.cwiseAbs().maxCoeff() / max_distance > kFarthestCell) continue;
       world.push_back(w);
       scan_of.push_back(i);
+      index_in_scan.push_back(k);
     }
   RevisitConsistency2D out;
   if (world.empty()) return out;
@@ -165,18 +167,15 @@ RevisitConsistency2D revisit_consistency_2d(const std::vector<Scan2D>& scans,
   };
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
   for (std::size_t j = 0; j < world.size(); ++j) cells[key(cell_of(world[j]))].push_back(j);
-  // A wall's neighbour on the surface: the next point of its scan, unless a gap lies between.
-  constexpr double kMaxSegment = 0.3;
+  // As the fine stage's fit check measures a point (surface_distance): to the other visit's
+  // surface, the segments to its beam neighbours, or beyond a surface's end to the end itself.
+  constexpr double kMaxSegment = 0.3;  // longer segments span a gap, not a surface
   const auto surface_distance = [&](std::size_t i, std::size_t j, double squared) {
     const std::size_t b = scan_of[j];
-    const std::size_t next = j + 1 < world.size() && scan_of[j + 1] == b ? j + 1 : j - 1;
-    if (next < world.size() && scan_of[next] == b) {
-      const Eigen::Vector2d along = world[next] - world[j];
-      const double length = along.norm();
-      if (length > 0.0 && length < kMaxSegment)
-        return std::abs(Eigen::Vector2d(-along.y(), along.x()).dot(world[i] - world[j])) / length;
-    }
-    return std::sqrt(squared);
+    const Eigen::Vector2d local = poses[b].inverse() * world[i];
+    const auto projected =
+        project_onto_neighbour_segments(scans[b], index_in_scan[j], local, kMaxSegment);
+    return projected ? (projected->point - local).norm() : std::sqrt(squared);
   };
   std::vector<double> distance(queries, std::numeric_limits<double>::quiet_NaN());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries), [&](const auto& range) {

@@ -47,11 +47,11 @@ AbsoluteError2D absolute_trajectory_error_2d(const std::vector<Pose2>& reference
 /// How well the scans agree where the sensor came back, measured without a reference: a wall
 /// seen twice lies double in the map by as much as the two visits disagree. Each point (or every
 /// n-th, to look at most at `max_queries`) is compared with the nearest point of another visit,
-/// a scan at least `revisit_gap` scans away: its distance to the line through that point and its
-/// beam neighbour (the surface there), capped at `max_distance`. Points with no other visit's
-/// point within `max_distance` do not count, nor points not finite or 10^9 times max_distance
-/// away (a diverged run). The poses' own noise and sparse far samples set a floor (means of
-/// 2-7 cm with the Radish logs' corrected poses).
+/// a scan at least `revisit_gap` scans away: its distance to that scan's surface there (the
+/// segments to the point's beam neighbours, as the 2D fit check measures), capped at
+/// `max_distance`. Points with no other visit's point within `max_distance` do not count, nor
+/// points not finite or 10^9 times max_distance away (a diverged run). The poses' own noise and
+/// sparse far samples set a floor (means of 2-7 cm with the Radish logs' corrected poses).
 struct RevisitConsistency2D {
   std::size_t points = 0;     ///< points looked at
   std::size_t revisited = 0;  ///< of those, with another visit's point within max_distance
