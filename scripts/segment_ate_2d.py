@@ -5,8 +5,8 @@ Usage: scripts/segment_ate_2d.py REFERENCE_TUM ESTIMATE_TUM FIRST_SCAN_OF_SECOND
 
 Each part is aligned on its own, so a single bad relative pose between the parts (in the estimate
 or in the reference) shows as a large ATE over all scans with small ATEs within the parts. Used in
-docs/planar.md for the fhw log, whose corrected poses turn 79 degrees too far between scans 58
-and 59. Needs python3-numpy (Debian).
+docs/planar.md for the fhw log, where our odometry loses 70-85 degrees in the spin at scans 40-65
+(the break falls at scans 58 -> 59). Needs python3-numpy (Debian).
 """
 import math
 import sys
