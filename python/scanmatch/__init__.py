@@ -8,7 +8,8 @@ as numpy arrays:
   and ``poses`` (N x 4 x 4)
 * ``simulate(preset, frames=..., seed=...)`` -> Simulation (frames, timestamps, ground truth)
 * ``read_cloud(path)`` / ``write_cloud(path, points, ...)``
-* ``eval.ate(gt_poses, est_poses)`` / ``eval.rpe(...)``
+* ``eval.ate(gt_poses, est_poses)`` / ``eval.rpe(...)``; in 2D ``eval.ate_2d``, ``eval.rpe_2d``,
+  ``eval.all_pairs_error_2d`` and ``eval.revisit_consistency_2d``
 * 2D: ``register2d(current, reference, ...)`` and ``Mapper2D``
 * loop closure: ``LoopClosure2D(**options)`` with ``add_scan(points, odometry_pose)``, ``finish()``,
   ``poses`` (optimized, N x 3 x 3) and ``loops``; ``LoopClosure3D`` likewise with

@@ -195,6 +195,21 @@ py::array_t<double> pose2_to_array(const Pose2& T) {
   return out;
 }
 
+std::vector<Pose2> poses2_from_array(py::handle obj, const std::string& name) {
+  const py::array a = numeric_array(obj, name);
+  const bool matrices = a.ndim() == 3 && a.shape(1) == 3 && a.shape(2) == 3;
+  const bool rows = a.ndim() == 2 && a.shape(1) == 3;
+  if (!matrices && !rows)
+    throw py::value_error(
+        name + ": expected an array of shape (N, 3, 3) or (N, 3) of x y theta, got " + shape_of(a));
+  std::vector<Pose2> poses;
+  poses.reserve(static_cast<std::size_t>(a.shape(0)));
+  py::object sequence = py::reinterpret_borrow<py::object>(a);
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    poses.push_back(pose2_from(sequence[py::int_(i)], name + "[" + std::to_string(i) + "]"));
+  return poses;
+}
+
 py::array_t<double> poses2_to_array(const std::vector<Pose2>& poses) {
   py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{3}, py::ssize_t{3}});
   auto o = out.mutable_unchecked<3>();

@@ -60,6 +60,9 @@ Scan2D scan_from_arrays(py::handle points, py::handle times, bool circular,
 /// A 3x3 homogeneous rigid transform or (x, y, theta); None gives the identity.
 Pose2 pose2_from(py::handle obj, const std::string& name);
 py::array_t<double> pose2_to_array(const Pose2& T);
+/// An (N, 3, 3) array of such transforms or an (N, 3) array of (x, y, theta) rows (or a sequence
+/// of either), each checked as pose2_from does.
+std::vector<Pose2> poses2_from_array(py::handle obj, const std::string& name);
 /// (N, 3, 3) float64 copies.
 py::array_t<double> poses2_to_array(const std::vector<Pose2>& poses);
 
