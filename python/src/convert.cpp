@@ -118,16 +118,26 @@ py::array_t<double> pose_to_array(const Pose& pose) {
   return out;
 }
 
+namespace {
+
+// Converts each entry along an array's first axis, named name[i] in errors.
+template <typename P, typename Convert>
+std::vector<P> each_pose(const py::array& a, const std::string& name, Convert convert) {
+  std::vector<P> poses;
+  poses.reserve(static_cast<std::size_t>(a.shape(0)));
+  py::object sequence = py::reinterpret_borrow<py::object>(a);
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    poses.push_back(convert(sequence[py::int_(i)], name + "[" + std::to_string(i) + "]"));
+  return poses;
+}
+
+}  // namespace
+
 std::vector<Pose> poses_from_array(py::handle obj, const std::string& name) {
   const py::array a = numeric_array(obj, name);
   if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
     throw py::value_error(name + ": expected an array of shape (N, 4, 4), got " + shape_of(a));
-  std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(a.shape(0)));
-  py::object sequence = py::reinterpret_borrow<py::object>(a);
-  for (py::ssize_t i = 0; i < a.shape(0); ++i)
-    poses.push_back(pose_from_array(sequence[py::int_(i)], name + "[" + std::to_string(i) + "]"));
-  return poses;
+  return each_pose<Pose>(a, name, pose_from_array);
 }
 
 py::array_t<double> poses_to_array(const std::vector<Pose>& poses) {
@@ -202,12 +212,7 @@ std::vector<Pose2> poses2_from_array(py::handle obj, const std::string& name) {
   if (!matrices && !rows)
     throw py::value_error(
         name + ": expected an array of shape (N, 3, 3) or (N, 3) of x y theta, got " + shape_of(a));
-  std::vector<Pose2> poses;
-  poses.reserve(static_cast<std::size_t>(a.shape(0)));
-  py::object sequence = py::reinterpret_borrow<py::object>(a);
-  for (py::ssize_t i = 0; i < a.shape(0); ++i)
-    poses.push_back(pose2_from(sequence[py::int_(i)], name + "[" + std::to_string(i) + "]"));
-  return poses;
+  return each_pose<Pose2>(a, name, pose2_from);
 }
 
 py::array_t<double> poses2_to_array(const std::vector<Pose2>& poses) {
