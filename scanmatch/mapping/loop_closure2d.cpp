@@ -12,6 +12,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
+#include "scanmatch/registration/planar/reference2d.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch {
@@ -241,13 +242,14 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
     }
   }
   const Scan2D& reference_scan = joined ? submap : candidate;
+  const Reference2D registration_reference(reference_scan);  // also for the sliding re-fit
   try {
     const CorrelativeMatch match = correlative_match(
         current, reference_scan, initial, options.search_window, options.search_angle,
         options.search_resolution, r.search_fill_gap, options.min_search_score);
     out.search_score = match.score;
     if (!match.found) return out;
-    out.transform = refine_searched(current, reference_scan, r, match.pose).transform;
+    out.transform = refine_searched(current, registration_reference, r, match.pose).transform;
   } catch (const Error&) {
     return out;  // too few usable points for the method: not verifiable, so not a loop
   }
@@ -311,7 +313,7 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
   Pose2 anchored = out.transform;
   anchored.translation() += axis * axis.dot(slide_anchor.translation() - anchored.translation());
   try {
-    out.transform = refine_searched(current, reference_scan, r, anchored).transform;
+    out.transform = refine_searched(current, registration_reference, r, anchored).transform;
   } catch (const Error&) {
     return out;
   }

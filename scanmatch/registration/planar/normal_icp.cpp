@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "scanmatch/registration/planar/point_to_point.hpp"
+#include "scanmatch/registration/planar/reference2d.hpp"
 
 namespace scanmatch {
 namespace {
@@ -31,8 +32,9 @@ std::vector<Vec2> scan_normals(const std::vector<Vec2>& points, bool circular, d
 }  // namespace
 
 // The normal-icp line of the method table (registration2d.cpp).
-Registration2DResult run_normal_icp(const Scan2D& current, const Scan2D& reference,
+Registration2DResult run_normal_icp(const Scan2D& current, const Reference2D& prepared,
                                     const Registration2DOptions& o, const Pose2& initial) {
+  const Scan2D& reference = prepared.scan();
   const double gap = 3 * o.max_correspondence_distance;
   const std::vector<Vec2> reference_normals =
       scan_normals(reference.points, reference.circular, gap);
@@ -43,7 +45,7 @@ Registration2DResult run_normal_icp(const Scan2D& current, const Scan2D& referen
     const Vec2 nc = R * current_normals[i];
     return !(nr.isZero() || nc.isZero() || std::abs(nr.dot(nc)) < min_cos);
   };
-  return planar::point_to_point_icp(current, reference, o, initial, true, normals_agree);
+  return planar::point_to_point_icp(current, prepared, o, initial, true, normals_agree);
 }
 
 }  // namespace scanmatch

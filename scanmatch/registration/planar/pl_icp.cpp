@@ -7,23 +7,24 @@
 #include <cmath>
 #include <limits>
 
-#include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/registration/planar/common.hpp"
-#include "scanmatch/registration/planar/line_fitting.hpp"
 #include "scanmatch/registration/planar/point_to_line.hpp"
+#include "scanmatch/registration/planar/reference2d.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch {
 
 // The pl-icp line of the method table (registration2d.cpp).
-Registration2DResult run_pl_icp(const Scan2D& current, const Scan2D& reference,
+Registration2DResult run_pl_icp(const Scan2D& current, const Reference2D& prepared,
                                 const Registration2DOptions& o, const Pose2& initial) {
   using Vec2 = Eigen::Vector2d;
-  const KdTree2 tree(reference.points);
+  const Scan2D& reference = prepared.scan();
+  const KdTree2& tree = prepared.tree();
   const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
-  std::vector<FittedLine> lines;
-  if (o.pl_line_radius > 0.0)
-    lines = fit_scan_lines(reference, o.pl_line_radius, o.max_correspondence_distance);
+  const std::vector<FittedLine> no_lines;
+  const std::vector<FittedLine>& lines =
+      o.pl_line_radius > 0.0 ? prepared.lines(o.pl_line_radius, o.max_correspondence_distance)
+                             : no_lines;
   std::vector<planar::LinePair> pairs;
   Registration2DResult r;
   r.transform = initial;

@@ -4,11 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/registration/planar/common.hpp"
+#include "scanmatch/registration/planar/reference2d.hpp"
 
 namespace scanmatch {
 
@@ -32,11 +31,11 @@ Pose2 align_svd(const std::vector<Vec2>& from, const std::vector<Vec2>& to) {
 
 namespace planar {
 
-Registration2DResult point_to_point_icp(const Scan2D& current, const Scan2D& reference,
+Registration2DResult point_to_point_icp(const Scan2D& current, const Reference2D& prepared,
                                         const Registration2DOptions& o, const Pose2& initial,
                                         bool use_tree, const PairFilter& keep) {
-  std::optional<KdTree2> tree;
-  if (use_tree) tree.emplace(reference.points);
+  const Scan2D& reference = prepared.scan();
+  const KdTree2* tree = use_tree ? &prepared.tree() : nullptr;
   const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
   // The nearest reference point to p within the correspondence distance.
   const auto nearest = [&](const Vec2& p, std::size_t& index, double& squared) {
@@ -85,11 +84,11 @@ Registration2DResult point_to_point_icp(const Scan2D& current, const Scan2D& ref
 }  // namespace planar
 
 // The icp and icp-kdtree lines of the method table (registration2d.cpp).
-Registration2DResult run_icp(const Scan2D& current, const Scan2D& reference,
+Registration2DResult run_icp(const Scan2D& current, const Reference2D& reference,
                              const Registration2DOptions& options, const Pose2& initial) {
   return planar::point_to_point_icp(current, reference, options, initial, false);
 }
-Registration2DResult run_icp_kdtree(const Scan2D& current, const Scan2D& reference,
+Registration2DResult run_icp_kdtree(const Scan2D& current, const Reference2D& reference,
                                     const Registration2DOptions& options, const Pose2& initial) {
   return planar::point_to_point_icp(current, reference, options, initial, true);
 }

@@ -33,9 +33,9 @@ struct PointPairs {
 using PairFilter = std::function<bool(std::size_t i, std::size_t j, const Eigen::Matrix2d& R)>;
 
 /// Point-to-point ICP: each current point against its nearest reference point within the
-/// correspondence distance (brute force, or a k-d tree with `use_tree`), pairs passing `keep`
-/// (empty: all), then the SVD step.
-Registration2DResult point_to_point_icp(const Scan2D& current, const Scan2D& reference,
+/// correspondence distance (brute force, or the reference's k-d tree with `use_tree`), pairs
+/// passing `keep` (empty: all), then the SVD step.
+Registration2DResult point_to_point_icp(const Scan2D& current, const Reference2D& reference,
                                         const Registration2DOptions& options, const Pose2& initial,
                                         bool use_tree, const PairFilter& keep = {});
 

@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 #include "scanmatch/registration/planar/line_fitting.hpp"
+#include "scanmatch/registration/planar/reference2d.hpp"
 
 namespace scanmatch {
 
@@ -103,14 +103,14 @@ void check_registration_2d_options(const Registration2DOptions& o) {
 
 namespace {
 
-/// surface_distance against one reference, its k-d tree built once for any number of poses.
+/// surface_distance against one reference, for any number of poses.
 class SurfaceDistance {
  public:
-  SurfaceDistance(const Scan2D& reference, double max_gap, double cap)
-      : reference_(reference), tree_(reference.points), max_gap_(max_gap), cap_(cap) {}
+  SurfaceDistance(const Reference2D& reference, double max_gap, double cap)
+      : reference_(reference), max_gap_(max_gap), cap_(cap) {}
 
   double operator()(const Scan2D& current, const Pose2& pose) const {
-    if (current.points.empty() || reference_.points.empty()) return cap_;
+    if (current.points.empty() || reference_.scan().points.empty()) return cap_;
     const double radius = cap_ + max_gap_;
     double sum = 0.0;
     for (const Eigen::Vector2d& p : current.points) {
@@ -120,8 +120,8 @@ class SurfaceDistance {
       double d = cap_;
       // The nearest sample's segments: a point between two samples of a wall is nearest to one
       // of them. Beyond a surface's end the end itself is the nearest.
-      if (tree_.nearest(q, radius * radius, k, squared)) {
-        const auto projected = project_onto_neighbour_segments(reference_, k, q, max_gap_);
+      if (reference_.tree().nearest(q, radius * radius, k, squared)) {
+        const auto projected = project_onto_neighbour_segments(reference_.scan(), k, q, max_gap_);
         d = projected ? (projected->point - q).norm() : std::sqrt(squared);
       }
       sum += std::min(d, cap_);
@@ -130,14 +130,13 @@ class SurfaceDistance {
   }
 
  private:
-  const Scan2D& reference_;
-  KdTree2 tree_;
+  const Reference2D& reference_;
   double max_gap_, cap_;
 };
 
 /// refine_searched once the options and scans are checked.
 Registration2DResult refine_checked(const Registration2DMethod& method, const Scan2D& current,
-                                    const Scan2D& reference, const Registration2DOptions& o,
+                                    const Reference2D& reference, const Registration2DOptions& o,
                                     const Pose2& searched) {
   Registration2DResult r = method.run(current, reference, o, searched);
   if (o.fine_fit_margin < 0.0) return r;
@@ -157,20 +156,27 @@ Registration2DResult refine_checked(const Registration2DMethod& method, const Sc
 Registration2DResult register_scans(const Scan2D& current, const Scan2D& reference,
                                     const Registration2DOptions& o, const Pose2& initial) {
   const Registration2DMethod& method = checked_method(current, reference, o);
-  if (!(o.search_window > 0.0)) return method.run(current, reference, o, initial);
+  const Reference2D prepared(reference);
+  if (!(o.search_window > 0.0)) return method.run(current, prepared, o, initial);
   const Pose2 searched = correlative_search(current, reference, initial, o.search_window,
                                             o.search_angle, o.search_resolution, o.search_fill_gap);
-  return refine_checked(method, current, reference, o, searched);
+  return refine_checked(method, current, prepared, o, searched);
 }
 
 double surface_distance(const Scan2D& current, const Scan2D& reference, const Pose2& pose,
                         double max_gap, double cap) {
-  return SurfaceDistance(reference, max_gap, cap)(current, pose);
+  return SurfaceDistance(Reference2D(reference), max_gap, cap)(current, pose);
 }
 
 Registration2DResult refine_searched(const Scan2D& current, const Scan2D& reference,
                                      const Registration2DOptions& o, const Pose2& searched) {
-  return refine_checked(checked_method(current, reference, o), current, reference, o, searched);
+  return refine_searched(current, Reference2D(reference), o, searched);
+}
+
+Registration2DResult refine_searched(const Scan2D& current, const Reference2D& reference,
+                                     const Registration2DOptions& o, const Pose2& searched) {
+  return refine_checked(checked_method(current, reference.scan(), o), current, reference, o,
+                        searched);
 }
 
 }  // namespace scanmatch

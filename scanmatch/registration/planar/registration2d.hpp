@@ -109,8 +109,11 @@ struct Registration2DResult {
   bool search_pose_kept = false;
 };
 
+class Reference2D;  // reference2d.hpp
+
 /// How a method runs: `current` onto `reference` from `initial`, with checked options and scans.
-using Registration2DRun = Registration2DResult(const Scan2D& current, const Scan2D& reference,
+/// What it builds of the reference it takes from `reference`, which keeps it for the next run.
+using Registration2DRun = Registration2DResult(const Scan2D& current, const Reference2D& reference,
                                                const Registration2DOptions& options,
                                                const Pose2& initial);
 
@@ -135,6 +138,9 @@ double surface_distance(const Scan2D& current, const Scan2D& reference, const Po
 /// than `searched` by fine_fit_margin (else `searched` with search_pose_kept set).
 /// options.search_window is ignored.
 Registration2DResult refine_searched(const Scan2D& current, const Scan2D& reference,
+                                     const Registration2DOptions& options, const Pose2& searched);
+/// The same onto a prepared reference, whose structures serve every refinement onto it.
+Registration2DResult refine_searched(const Scan2D& current, const Reference2D& reference,
                                      const Registration2DOptions& options, const Pose2& searched);
 
 /// "sparse-icp, icp, ...": the names for help texts and errors.

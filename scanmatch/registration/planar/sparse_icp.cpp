@@ -10,6 +10,7 @@
 #include "scanmatch/registration/planar/line_fitting.hpp"
 #include "scanmatch/registration/planar/point_to_line.hpp"
 #include "scanmatch/registration/planar/point_to_point.hpp"
+#include "scanmatch/registration/planar/reference2d.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch {
@@ -36,8 +37,9 @@ Pose2 coarse_alignment_2d(const std::vector<Vec2>& current, const std::vector<Ve
 }
 
 // The sparse-icp line of the method table (registration2d.cpp).
-Registration2DResult run_sparse_icp(const Scan2D& current, const Scan2D& reference,
+Registration2DResult run_sparse_icp(const Scan2D& current, const Reference2D& prepared,
                                     const Registration2DOptions& o, const Pose2& initial) {
+  const Scan2D& reference = prepared.scan();
   // The correlative search, when it ran, replaces the coarse stage.
   const bool coarse = !(o.search_window > 0.0);
   Registration2DResult r;
@@ -53,9 +55,11 @@ Registration2DResult run_sparse_icp(const Scan2D& current, const Scan2D& referen
   const bool point_to_line = o.sparse_step == "point-to-line";
   PathTracer path_tracer(reference.points, reference.circular, o.max_correspondence_distance,
                          o.path_rules);
-  std::vector<FittedLine> lines;
-  if (point_to_line && o.sparse_line_radius > 0.0)
-    lines = fit_scan_lines(reference, o.sparse_line_radius, o.max_correspondence_distance);
+  const std::vector<FittedLine> no_lines;
+  const std::vector<FittedLine>& lines =
+      point_to_line && o.sparse_line_radius > 0.0
+          ? prepared.lines(o.sparse_line_radius, o.max_correspondence_distance)
+          : no_lines;
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
     const std::vector<Vec2> moved = planar::transformed(current.points, r.transform);
     const CorrespondencePath path = path_tracer.trace(moved);
