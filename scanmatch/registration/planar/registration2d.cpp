@@ -112,6 +112,7 @@ class SurfaceDistance {
   double operator()(const Scan2D& current, const Pose2& pose) const {
     if (current.points.empty() || reference_.scan().points.empty()) return cap_;
     const double radius = cap_ + max_gap_;
+    const KdTree2& tree = reference_.tree();  // once: each call takes the reference's lock
     double sum = 0.0;
     for (const Eigen::Vector2d& p : current.points) {
       const Eigen::Vector2d q = pose * p;
@@ -120,7 +121,7 @@ class SurfaceDistance {
       double d = cap_;
       // The nearest sample's segments: a point between two samples of a wall is nearest to one
       // of them. Beyond a surface's end the end itself is the nearest.
-      if (reference_.tree().nearest(q, radius * radius, k, squared)) {
+      if (tree.nearest(q, radius * radius, k, squared)) {
         const auto projected = project_onto_neighbour_segments(reference_.scan(), k, q, max_gap_);
         d = projected ? (projected->point - q).norm() : std::sqrt(squared);
       }
