@@ -67,6 +67,8 @@ py::dict counts_dict(const LoopClosure2DCounts& c) {
   d["outliers"] = c.outliers;
   d["optimizations"] = c.optimizations;
   d["open_odometry_edges"] = c.open_odometry_edges;
+  d["rotation_open_odometry_edges"] = c.rotation_open_odometry_edges;
+  d["turned_at_open_rotation"] = c.turned_at_open_rotation;
   d["total_ms"] = c.total_ms;
   return d;
 }

@@ -346,6 +346,10 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error(
         "loop closure: the odometry spread's window, margin, normal and open spreads must not "
         "be negative");
+  if (!(options.rotation_open_ratio >= 0.0) || !(options.rotation_open_sigma_theta > 0.0))
+    throw Error(
+        "loop closure: rotation_open_ratio must not be negative and rotation_open_sigma_theta "
+        "must be positive");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
   if (!(options.recheck_above >= 0.0))
@@ -379,6 +383,18 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
       information = odometry_information(keyframes_.back().points, scan, motion);
       new_keyframe = new_keyframe || information->open;
     }
+    if (new_keyframe) {
+      // Only keyframe steps: the test searches 160 degrees of rotation.
+      if (options_.rotation_open_ratio > 0.0 &&
+          rotation_ambiguity_2d(scan, keyframes_.back().points, motion) >=
+              options_.rotation_open_ratio) {
+        information->rotation_open = true;
+        information->information.row(2).setZero();
+        information->information.col(2).setZero();
+        information->information(2, 2) =
+            1.0 / (options_.rotation_open_sigma_theta * options_.rotation_open_sigma_theta);
+      }
+    }
   }
   if (new_keyframe) {
     Keyframe k;
@@ -397,6 +413,8 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
       graph_.graph().add_edge(index - 1, index, measurement, information->information,
                               EdgeKind::kOdometry);
       if (information->open) ++counts_.open_odometry_edges;
+      k.rotation_open = information->rotation_open;
+      if (k.rotation_open) ++counts_.rotation_open_odometry_edges;
       keyframes_.push_back(std::move(k));
     }
     places_.add(make_place_descriptor(scan, options_.descriptor));
@@ -486,8 +504,11 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
         options_.max_correction +
         options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
     if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
-      ++counts_.rejected_by_estimate;
-      continue;
+      if (!agrees_turned_at_open_rotation(k, keyframe, graph().pose(k) * v.transform, allowed)) {
+        ++counts_.rejected_by_estimate;
+        continue;
+      }
+      ++counts_.turned_at_open_rotation;
     }
     ++counts_.verified;
     if (v.sliding) ++counts_.sliding;
@@ -508,6 +529,21 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     graph_.add_loop(loop, information);
   }
   return stale;
+}
+
+bool LoopClosure2D::agrees_turned_at_open_rotation(std::size_t older, std::size_t newer,
+                                                   const Pose2& implied, double allowed) const {
+  const Pose2& here = graph().pose(newer);
+  const double turn = pose2_angle(here.inverse() * implied);
+  const Eigen::Rotation2Dd rotation(turn);
+  for (std::size_t m = older + 1; m <= newer; ++m) {
+    if (!keyframes_[m].rotation_open) continue;
+    // Keyframe m's heading is open: it and every keyframe after it turn about its position.
+    const Eigen::Vector2d pivot = graph().pose(m).translation();
+    const Eigen::Vector2d turned = pivot + rotation * (here.translation() - pivot);
+    if ((turned - implied.translation()).norm() <= allowed) return true;
+  }
+  return false;
 }
 
 Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) const {
@@ -535,6 +571,31 @@ Eigen::Matrix3d spread_odometry_information(const Eigen::Matrix2d& spread, const
                                       widened.cwiseInverse().asDiagonal() *
                                       eigen.eigenvectors().transpose() * to_residual.transpose();
   return information;
+}
+
+double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
+                             const Pose2& measurement, double window) {
+  constexpr double kNear = 4.0 * M_PI / 180;
+  constexpr double kFarFrom = 10.0 * M_PI / 180, kFarTo = 90.0 * M_PI / 180;
+  const double fill_gap = Registration2DOptions{}.search_fill_gap;
+  try {
+    const double near = correlative_match(current, previous, measurement, window, kNear,
+                                          kStepSpreadResolution, fill_gap)
+                            .score;
+    if (!(near > 0.0)) return 0.0;
+    double far = 0.0;
+    for (const double side : {-1.0, 1.0}) {
+      const Pose2 turned = pose2(measurement.translation().x(), measurement.translation().y(),
+                                 pose2_angle(measurement) + side * 0.5 * (kFarFrom + kFarTo));
+      far = std::max(far,
+                     correlative_match(current, previous, turned, window, 0.5 * (kFarTo - kFarFrom),
+                                       kStepSpreadResolution, fill_gap)
+                         .score);
+    }
+    return far / near;
+  } catch (const Error&) {
+    return 0.0;  // too few points to score: nothing to tell
+  }
 }
 
 LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(

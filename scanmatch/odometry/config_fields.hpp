@@ -419,6 +419,11 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("open_steps_are_keyframes", o.open_steps_are_keyframes, nullptr,
     "A scan whose step is open becomes a keyframe however little the odometry moved");
   v("open_step_spread", o.open_step_spread, nullptr, "... open: its spread is at least this, m");
+  v("rotation_open_ratio", o.rotation_open_ratio, nullptr,
+    "A keyframe step whose rotations 10-90 deg off fit this share of its own is rotation-open "
+    "(0: off)");
+  v("rotation_open_sigma_theta", o.rotation_open_sigma_theta, nullptr,
+    "... its odometry edge's rotation standard deviation, rad");
   v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
   v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
