@@ -384,8 +384,9 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
       new_keyframe = new_keyframe || information->open;
     }
     if (new_keyframe) {
-      // Only keyframe steps: the test searches 160 degrees of rotation.
+      // Only keyframe steps that turn: the test searches 160 degrees of rotation.
       if (options_.rotation_open_ratio > 0.0 &&
+          std::abs(pose2_angle(motion)) >= options_.rotation_open_min_turn &&
           rotation_ambiguity_2d(scan, keyframes_.back().points, motion) >=
               options_.rotation_open_ratio) {
         information->rotation_open = true;

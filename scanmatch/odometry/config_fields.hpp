@@ -424,6 +424,8 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
     "(0: off)");
   v("rotation_open_sigma_theta", o.rotation_open_sigma_theta, nullptr,
     "... its odometry edge's rotation standard deviation, rad");
+  v("rotation_open_min_turn", o.rotation_open_min_turn, nullptr,
+    "... tested only where the step turns at least this much, rad");
   v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
   v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
