@@ -546,6 +546,23 @@ TEST(LoopClosure2D, CarmenLogStartIfPresent) {
             summary["ate_odometry"]["rmse_m"].get<double>() * 1.05);
 }
 
+// `map2d LOG --scans N --loop-closure` into dir/name, with `config` (JSON; empty: none) as its
+// --config; its summary.json. The run's loops.json is dir/name/loops.json.
+nlohmann::json run_loop_closed_log(const std::string& log, int scans, const std::string& config,
+                                   const scanmatch::testing::TempDir& dir,
+                                   const std::string& name) {
+  std::string options;
+  if (!config.empty()) {
+    std::ofstream(dir.file(name + ".json")) << config;
+    options = " --config " + dir.file(name + ".json");
+  }
+  const auto r =
+      scanmatch::testing::run_cli("map2d " + log + " --scans " + std::to_string(scans) +
+                                  " --loop-closure --quiet" + options + " --out " + dir.file(name));
+  EXPECT_EQ(r.status, 0) << r.output;
+  return nlohmann::json::parse(std::ifstream(dir.file(name + "/summary.json")));
+}
+
 TEST(LoopClosure2D, KeyframesBeforeABigCorrectionLookAgainIfPresent) {
   // ACES's first 270 scans: a long dead end (scans 163-251) whose way back reaches its mouth, by
   // the start, with the odometry 4 m off; the proximity candidates there lie beyond the search
@@ -556,21 +573,13 @@ TEST(LoopClosure2D, KeyframesBeforeABigCorrectionLookAgainIfPresent) {
   if (log.empty()) GTEST_SKIP() << "../shared/data/2d/carmen is absent";
   if (scanmatch::testing::sanitized()) GTEST_SKIP() << "too slow under the sanitizers";
   scanmatch::testing::TempDir dir;
-  {
-    std::ofstream config(dir.file("no_recheck.json"));
-    config << R"({"loop": {"recheck_keyframes": 0}})";
-  }
   struct Run {
     double ate = 0.0, ate_odometry = 0.0;
     std::size_t start_to_mouth = 0;  ///< loops from the first 60 scans to scans 240 and later
   };
-  const auto run = [&](const std::string& name, const std::string& options) {
-    const auto r =
-        scanmatch::testing::run_cli("map2d " + log + " --scans 270 --loop-closure --quiet " +
-                                    options + " --out " + dir.file(name));
-    EXPECT_EQ(r.status, 0) << r.output;
+  const auto run = [&](const std::string& name, const std::string& config) {
     Run out;
-    const auto summary = nlohmann::json::parse(std::ifstream(dir.file(name + "/summary.json")));
+    const auto summary = run_loop_closed_log(log, 270, config, dir, name);
     out.ate = summary["ate"]["rmse_m"].get<double>();
     out.ate_odometry = summary["ate_odometry"]["rmse_m"].get<double>();
     for (const auto& l : nlohmann::json::parse(std::ifstream(dir.file(name + "/loops.json"))))
@@ -578,7 +587,7 @@ TEST(LoopClosure2D, KeyframesBeforeABigCorrectionLookAgainIfPresent) {
     return out;
   };
   const Run rechecked = run("recheck", "");
-  const Run once = run("once", "--config " + dir.file("no_recheck.json"));
+  const Run once = run("once", R"({"loop": {"recheck_keyframes": 0}})");
   std::printf(
       "ACES 270 scans: ATE odometry %.3f m, loop-closed %.3f m with rechecks (%zu loops "
       "start-mouth), %.3f m without (%zu)\n",
@@ -598,19 +607,9 @@ TEST(LoopClosure2D, ALoopAcrossARotationOpenStepTurnsTheMapIfPresent) {
   if (log.empty()) GTEST_SKIP() << "../shared/data/2d/carmen is absent";
   if (scanmatch::testing::sanitized()) GTEST_SKIP() << "too slow under the sanitizers";
   scanmatch::testing::TempDir dir;
-  {
-    std::ofstream config(dir.file("off.json"));
-    config << R"({"loop": {"rotation_open_ratio": 0}})";
-  }
-  const auto run = [&](const std::string& name, const std::string& options) {
-    const auto r =
-        scanmatch::testing::run_cli("map2d " + log + " --scans 420 --loop-closure --quiet " +
-                                    options + " --out " + dir.file(name));
-    EXPECT_EQ(r.status, 0) << r.output;
-    return nlohmann::json::parse(std::ifstream(dir.file(name + "/summary.json")));
-  };
-  const auto turned = run("turned", "");
-  const auto held = run("held", "--config " + dir.file("off.json"));
+  const auto turned = run_loop_closed_log(log, 420, "", dir, "turned");
+  const auto held =
+      run_loop_closed_log(log, 420, R"({"loop": {"rotation_open_ratio": 0}})", dir, "held");
   const double odometry = turned["ate_odometry"]["rmse_m"].get<double>();
   const double closed = turned["ate"]["rmse_m"].get<double>();
   const double without = held["ate"]["rmse_m"].get<double>();
