@@ -428,6 +428,7 @@ TEST(LoopClosure2D, OptionsOutOfRangeAreRefused) {
   refused([](LoopClosure2DOptions& o) { o.odometry_spread_window = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.rotation_open_ratio = -0.1; });
   refused([](LoopClosure2DOptions& o) { o.rotation_open_sigma_theta = 0.0; });
+  refused([](LoopClosure2DOptions& o) { o.rotation_open_min_turn = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.verification.method = "no-such-method"; });
   EXPECT_NO_THROW(LoopClosure2D{LoopClosure2DOptions{}});
 }

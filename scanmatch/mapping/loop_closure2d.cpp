@@ -346,10 +346,11 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error(
         "loop closure: the odometry spread's window, margin, normal and open spreads must not "
         "be negative");
-  if (!(options.rotation_open_ratio >= 0.0) || !(options.rotation_open_sigma_theta > 0.0))
+  if (!(options.rotation_open_ratio >= 0.0) || !(options.rotation_open_min_turn >= 0.0) ||
+      !(options.rotation_open_sigma_theta > 0.0))
     throw Error(
-        "loop closure: rotation_open_ratio must not be negative and rotation_open_sigma_theta "
-        "must be positive");
+        "loop closure: rotation_open_ratio and rotation_open_min_turn must not be negative and "
+        "rotation_open_sigma_theta must be positive");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
   if (!(options.recheck_above >= 0.0))
@@ -383,19 +384,8 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
       information = odometry_information(keyframes_.back().points, scan, motion);
       new_keyframe = new_keyframe || information->open;
     }
-    if (new_keyframe) {
-      // Only keyframe steps that turn: the test searches 160 degrees of rotation.
-      if (options_.rotation_open_ratio > 0.0 &&
-          std::abs(pose2_angle(motion)) >= options_.rotation_open_min_turn &&
-          rotation_ambiguity_2d(scan, keyframes_.back().points, motion) >=
-              options_.rotation_open_ratio) {
-        information->rotation_open = true;
-        information->information.row(2).setZero();
-        information->information.col(2).setZero();
-        information->information(2, 2) =
-            1.0 / (options_.rotation_open_sigma_theta * options_.rotation_open_sigma_theta);
-      }
-    }
+    // Only keyframe steps: the rotation test searches 160 degrees.
+    if (new_keyframe) loosen_open_rotation(*information, keyframes_.back().points, scan, motion);
   }
   if (new_keyframe) {
     Keyframe k;
@@ -616,6 +606,19 @@ LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
                                   options_.odometry_sigma_theta, options_.odometry_spread_normal);
   out.open = widest_spread(spread).rms >= options_.open_step_spread;
   return out;
+}
+
+void LoopClosure2D::loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
+                                         const Scan2D& current, const Pose2& measurement) const {
+  if (!(options_.rotation_open_ratio > 0.0) ||
+      std::abs(pose2_angle(measurement)) < options_.rotation_open_min_turn ||
+      rotation_ambiguity_2d(current, previous, measurement) < options_.rotation_open_ratio)
+    return;
+  information.rotation_open = true;
+  information.information.row(2).setZero();
+  information.information.col(2).setZero();
+  information.information(2, 2) =
+      1.0 / (options_.rotation_open_sigma_theta * options_.rotation_open_sigma_theta);
 }
 
 void LoopClosure2D::optimize() {

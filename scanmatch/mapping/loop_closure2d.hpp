@@ -286,7 +286,7 @@ class LoopClosure2D {
     Scan2D points;
     Pose2 odometry = Pose2::Identity();
     double path = 0.0;           ///< m of odometry travel since the first keyframe
-    bool rotation_open = false;  ///< the odometry edge from the previous keyframe is
+    bool rotation_open = false;  ///< the odometry edge from the previous keyframe is so
   };
   /// Searches loops for the new keyframe, optimizes when they disagree with the estimate, and
   /// searches again for the keyframes before it when that moved the estimate far.
@@ -305,12 +305,16 @@ class LoopClosure2D {
   struct OdometryInformation {
     Eigen::Matrix3d information;
     bool open = false;           ///< the scans leave the step open (open_step_spread)
-    bool rotation_open = false;  ///< and its rotation (rotation_open_ratio)
+    bool rotation_open = false;  ///< the scans leave its rotation open (rotation_open_ratio)
   };
   /// The information of an odometry edge from `previous` to `current`, which the odometry put at
   /// `measurement` (current in previous's frame).
   OdometryInformation odometry_information(const Scan2D& previous, const Scan2D& current,
                                            const Pose2& measurement) const;
+  /// Marks a keyframe step rotation-open (rotation_open_ratio, for steps that turn at least
+  /// rotation_open_min_turn) and loosens its edge's rotation to rotation_open_sigma_theta.
+  void loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
+                            const Scan2D& current, const Pose2& measurement) const;
   void optimize();
 
   LoopClosure2DOptions options_;
