@@ -155,7 +155,7 @@ void add_map2d_command(CLI::App& app) {
                        ? fmt::format(" (odometry map {:.3f})", s.map_agreement_odometry)
                        : "");
       if (s.consistency_odometry.revisited > 0) {
-        const RevisitConsistency2D& c =
+        const RevisitConsistency2D& shown =
             s.loop_closure ? s.consistency_optimized : s.consistency_odometry;
         std::string others;
         if (s.loop_closure)
@@ -166,7 +166,8 @@ void add_map2d_command(CLI::App& app) {
         fmt::print(
             "revisit consistency (no reference needed): walls of revisits {:.1f} cm apart, mean "
             "over {:.0f} % of the points{}\n",
-            100 * c.mean, 100.0 * static_cast<double>(c.revisited) / static_cast<double>(c.points),
+            100 * shown.mean,
+            100.0 * static_cast<double>(shown.revisited) / static_cast<double>(shown.points),
             others.empty() ? "" : " (" + others + ")");
       }
       if (!s.map_error.empty()) fmt::print("no map written: {}\n", s.map_error);
