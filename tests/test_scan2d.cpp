@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -583,6 +584,54 @@ TEST(Map2D, WideSearchFindsATurnBeyondTheSearchAngle) {
   EXPECT_GT(std::abs(degrees(pose2_angle(narrow)) - 75.0), 20.0);
 }
 
+TEST(Map2D, WholeTurnSearchFindsACornerBeyondTheWideSearch) {
+  // corridor-2d driven for 800 scans turns its corners in one 1 Hz step of up to 91 degrees, and
+  // after such a step the constant-velocity guess expects another turn: the truth then lies
+  // beyond +-90 degrees of the guess (scans 149 and 150), where only a search over the whole
+  // turn finds it. Its steps fit poorly and are flagged weak for loop closure; at scan 82 the
+  // turn fits no better than going straight on (half the points either way), which the scans
+  // alone cannot decide: that one is left to loop closure (LoopClosure2D.AWeakStepIsTestedFor...).
+  sim::SimOptions options;
+  options.preset = "corridor-2d";
+  options.frames = 800;
+  const sim::Simulator simulator(options);
+  std::vector<std::size_t> weak;
+  const auto worst_turn_error = [&](const Mapper2DConfig& config, std::size_t first,
+                                    std::size_t end) {
+    Mapper2D mapper(config);
+    double worst = 0.0;
+    weak.clear();
+    LaserScan2D last = simulator.scan_2d(first);
+    Pose2 previous = mapper.add_scan(scan_from_laser(last), last.timestamp);
+    for (std::size_t i = first + 1; i < end; ++i) {
+      const LaserScan2D laser = simulator.scan_2d(i);
+      const Pose2 pose = mapper.add_scan(scan_from_laser(laser), laser.timestamp);
+      if (mapper.last_stats().weak_fit) weak.push_back(i);
+      const Pose2 truth = pose2(last.pose).inverse() * pose2(laser.pose);
+      const double error = pose2_angle(truth.inverse() * previous.inverse() * pose);
+      worst = std::max(worst, std::abs(degrees(error)));
+      previous = pose;
+      last = laser;
+    }
+    return worst;
+  };
+  Mapper2DConfig config;
+  config.registration.search_window = 1.3;        // map2d's default
+  ASSERT_GT(config.full_turn_search_below, 0.0);  // on by default
+  const double whole = worst_turn_error(config, 130, 170);
+  EXPECT_LT(whole, 3.0);
+  EXPECT_TRUE(std::find(weak.begin(), weak.end(), 149u) != weak.end());
+  EXPECT_LT(weak.size(), 5u);
+  worst_turn_error(config, 76, 90);
+  EXPECT_EQ(weak, std::vector<std::size_t>{82});
+  config.full_turn_search_below = 0.0;
+  const double wide = worst_turn_error(config, 130, 170);
+  EXPECT_GT(wide, 80.0);
+  EXPECT_TRUE(weak.empty());
+  std::printf("worst turn error over scans 130-169: %.1f deg with the whole turn, %.1f without\n",
+              whole, wide);
+}
+
 TEST(Map2D, SimulatedCorridorsKeepTheirStepsAndTurnTheirCorners) {
   // corridor-2d (1 Hz, about 1 m per scan, corners of up to 80 degrees): along plain stretches
   // the motion prior chooses the open steps; at a corner the prior (straight on) lies far from
@@ -628,6 +677,7 @@ TEST(Map2D, MapperRefusesOptionsOutOfRangeBeforeTheFirstScan) {
   refused([](Mapper2DConfig& c) { c.registration.keep_fraction = 1.5; });
   refused([](Mapper2DConfig& c) { c.registration.method = "no-such-method"; });
   refused([](Mapper2DConfig& c) { c.wide_search_angle = -0.1; });
+  refused([](Mapper2DConfig& c) { c.full_turn_search_below = std::nan(""); });
   refused([](Mapper2DConfig& c) { c.open_step_window = -1.0; });
   refused([](Mapper2DConfig& c) { c.open_step_prior_distance = std::nan(""); });
   EXPECT_NO_THROW(Mapper2D{Mapper2DConfig{}});

@@ -70,6 +70,7 @@ py::dict stats_dict(const Scan2DStats& s) {
   d["error"] = s.error;
   d["bridged"] = s.bridged;
   d["open_step_from_prior"] = s.open_step_from_prior;
+  d["weak_fit"] = s.weak_fit;
   return d;
 }
 

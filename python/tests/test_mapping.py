@@ -71,6 +71,22 @@ class LoopClosure2D(unittest.TestCase):
                 error -= axis * (axis @ error)
             self.assertLess(np.linalg.norm(error), 0.15)
 
+    def test_a_weak_step_is_tested_for_its_rotation(self):
+        # corridor-2d over 800 scans turns 90 deg between scans 81 and 82, where going straight on
+        # fits about as well: a step the odometry registered poorly (Mapper2D's weak_fit) takes
+        # the rotation test though it turned less than rotation_open_min_turn.
+        sim = scanmatch.Simulator("corridor-2d", frames=800)
+        before, after = sim.scan2d(81)[0], sim.scan2d(82)[0]
+
+        def open_edges(weak_fit):
+            closure = scanmatch.LoopClosure2D(keyframe_distance=0.5)
+            closure.add_scan(before, (0.0, 0.0, 0.0))
+            self.assertTrue(closure.add_scan(after, (0.81, 0.15, 0.0), weak_fit=weak_fit))
+            return closure.counts["rotation_open_odometry_edges"]
+
+        self.assertEqual(open_edges(False), 0)
+        self.assertEqual(open_edges(True), 1)
+
     def test_options_and_errors(self):
         options = scanmatch.loop_closure_2d_options()
         self.assertIn("verification.min_paired_fraction", options)

@@ -363,8 +363,9 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
   options_.search_every = std::max<std::size_t>(options_.search_every, 1);
 }
 
-bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
+bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, bool weak_fit) {
   const Stopwatch stopwatch;
+  weak_fit_since_keyframe_ = weak_fit_since_keyframe_ || weak_fit;
   // A non-finite odometry pose would poison the graph: hold the last one instead.
   Pose2 odometry = odometry_pose;
   if (!odometry.matrix().allFinite())
@@ -385,7 +386,9 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
       new_keyframe = new_keyframe || information->open;
     }
     // Only keyframe steps: the rotation test searches 160 degrees.
-    if (new_keyframe) loosen_open_rotation(*information, keyframes_.back().points, scan, motion);
+    if (new_keyframe)
+      loosen_open_rotation(*information, keyframes_.back().points, scan, motion,
+                           weak_fit_since_keyframe_);
   }
   if (new_keyframe) {
     Keyframe k;
@@ -408,6 +411,7 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose) {
       if (k.rotation_open) ++counts_.rotation_open_odometry_edges;
       keyframes_.push_back(std::move(k));
     }
+    weak_fit_since_keyframe_ = false;
     places_.add(make_place_descriptor(scan, options_.descriptor));
     ++counts_.keyframes;
     if (index % options_.search_every == 0) close_loops(index);
@@ -609,9 +613,10 @@ LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
 }
 
 void LoopClosure2D::loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
-                                         const Scan2D& current, const Pose2& measurement) const {
+                                         const Scan2D& current, const Pose2& measurement,
+                                         bool weak_fit) const {
   if (!(options_.rotation_open_ratio > 0.0) ||
-      std::abs(pose2_angle(measurement)) < options_.rotation_open_min_turn ||
+      (!weak_fit && std::abs(pose2_angle(measurement)) < options_.rotation_open_min_turn) ||
       rotation_ambiguity_2d(current, previous, measurement) < options_.rotation_open_ratio)
     return;
   information.rotation_open = true;

@@ -264,6 +264,8 @@ void describe(Mapper2DConfig& c, Visitor& v) {
     "rad: search again over +- this where few points fit (0: off)");
   v("wide_search_below", c.wide_search_below, nullptr,
     "share of points within 15 cm of the reference below which the wide search runs");
+  v("full_turn_search_below", c.full_turn_search_below, nullptr,
+    "share of points fitting after the wide search below which it runs over +- 180 deg (0: off)");
   v("open_step_window", c.open_step_window, nullptr,
     "m: where the scans leave a step open within this, the motion prior chooses (0: off)");
   v("open_step_margin", c.open_step_margin, nullptr,

@@ -11,8 +11,11 @@ namespace scanmatch {
 
 Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
   check_registration_2d_options(config.registration);
-  if (!(config.wide_search_angle >= 0.0) || !(config.wide_search_below >= 0.0))
-    throw Error("map2d: wide_search_angle and wide_search_below must not be negative");
+  if (!(config.wide_search_angle >= 0.0) || !(config.wide_search_below >= 0.0) ||
+      !(config.full_turn_search_below >= 0.0))
+    throw Error(
+        "map2d: wide_search_angle, wide_search_below and full_turn_search_below must not be "
+        "negative");
   if (!(config.open_step_window >= 0.0) || !(config.open_step_margin >= 0.0) ||
       !(config.open_step_spread >= 0.0) || !(config.open_step_prior_distance >= 0.0))
     throw Error(
@@ -20,15 +23,16 @@ Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
         "open_step_prior_distance must not be negative");
 }
 
-bool Mapper2D::plausible_correction(const Pose2& correction) const {
+bool Mapper2D::plausible_correction(const Pose2& correction, bool whole_turn) const {
   // Never rejects what the correlative search was asked to look for.
   const Registration2DOptions& r = config_.registration;
   const bool search = r.search_window > 0.0;
+  const double searched_angle =
+      whole_turn ? M_PI : std::max(r.search_angle, config_.wide_search_angle);
   return correction.translation().norm() <=
              std::max(config_.max_correction, search ? r.search_window + 0.5 : 0.0) &&
          std::abs(pose2_angle(correction)) <=
-             std::max(config_.max_correction_angle,
-                      search ? std::max(r.search_angle, config_.wide_search_angle) + 0.2 : 0.0);
+             std::max(config_.max_correction_angle, search ? searched_angle + 0.2 : 0.0);
 }
 
 namespace {
@@ -134,6 +138,7 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   const Scan2D& current = deskew ? current_deskewed : input;
   const Scan2D& reference = deskew ? keyframe_deskewed : keyframe_;
   Pose2 relative = guess;
+  bool whole_turn = false;
   const Stopwatch stopwatch;
   try {
     Registration2DResult r = register_scans(current, reference, config_.registration, guess);
@@ -141,18 +146,27 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
     if (o.search_window > 0.0 && config_.wide_search_angle > o.search_angle) {
       // A turn beyond the search's angle window leaves most points off the reference.
       const ScanFit fit(reference, o.search_fill_gap);
-      const double narrow = fit(current, r.transform);
-      if (narrow < config_.wide_search_below) {
-        Registration2DOptions wide = o;
-        wide.search_angle = config_.wide_search_angle;
-        const Registration2DResult w = register_scans(current, reference, wide, guess);
-        if (fit(current, w.transform) > narrow + 0.05) r = w;
-      }
+      double best = fit(current, r.transform);
+      // The wider search wins only where clearly more points fit: it finds more false matches.
+      const auto search_wider = [&](double angle) {
+        Registration2DOptions wider = o;
+        wider.search_angle = angle;
+        const Registration2DResult w = register_scans(current, reference, wider, guess);
+        const double fitted = fit(current, w.transform);
+        if (fitted <= best + 0.05) return false;
+        r = w;
+        best = fitted;
+        return true;
+      };
+      if (best < config_.wide_search_below) search_wider(config_.wide_search_angle);
+      stats_.weak_fit = best < config_.full_turn_search_below;
+      if (stats_.weak_fit && config_.wide_search_angle < M_PI) whole_turn = search_wider(M_PI);
     }
     if (config_.constant_velocity && config_.open_step_window > 0.0)
       r.transform = prior_along_open_direction(current, reference, r.transform, guess);
     const Pose2 correction = guess.inverse() * r.transform;
-    if (r.pairs >= 3 && r.transform.matrix().allFinite() && plausible_correction(correction)) {
+    if (r.pairs >= 3 && r.transform.matrix().allFinite() &&
+        plausible_correction(correction, whole_turn)) {
       relative = r.transform;
       stats_.iterations = r.iterations;
       stats_.pairs = r.pairs;

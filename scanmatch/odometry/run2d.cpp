@@ -142,11 +142,12 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   struct LoopInput {
     Scan2D scan;
     Pose2 pose = Pose2::Identity();
+    bool weak_fit = false;
   };
   // Loop closure is fed in scan order; it owns `loop_closure` until finish().
   BackgroundWorker<LoopInput> loop_worker(
-      [&](LoopInput& in) { loop_closure->add_scan(in.scan, in.pose); }, kLoopQueueScans,
-      options.loop_closure && options.loop_closure_thread);
+      [&](LoopInput& in) { loop_closure->add_scan(in.scan, in.pose, in.weak_fit); },
+      kLoopQueueScans, options.loop_closure && options.loop_closure_thread);
   const Stopwatch run_time;
   // The registered scans, kept to rebuild the map from the optimized poses and to measure how
   // well revisits agree.
@@ -186,7 +187,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       }
     };
     insert(grid, summary.map_error, pose);
-    if (loop_closure) loop_worker.push({mapper.last_scan(), pose});
+    if (loop_closure) loop_worker.push({mapper.last_scan(), pose, mapper.last_stats().weak_fit});
     Scan2D kept = mapper.last_scan();
     kept.misses = scan.misses;
     kept.times.clear();
