@@ -190,10 +190,11 @@ double moved_at_5m(const Pose2& change) {
   return change.translation().norm() + 5.0 * std::abs(pose2_angle(change));
 }
 
-// The information with nothing left along the translation `direction` (unit, in the residual's
-// frame) but a trace, 1e-6 of its largest eigenvalue, that keeps it positive definite.
-Eigen::Matrix3d without_direction(const Eigen::Matrix3d& information,
-                                  const Eigen::Vector2d& direction) {
+// The information with only `kept` (a share in [0, 1]) of what it holds along the translation
+// `direction` (unit, in the residual's frame), plus a trace, 1e-6 of its largest eigenvalue, that
+// keeps it positive definite when nothing is kept.
+Eigen::Matrix3d weakened_along(const Eigen::Matrix3d& information, const Eigen::Vector2d& direction,
+                               double kept) {
   Eigen::Vector3d u = Eigen::Vector3d::Zero();
   u.head<2>() = direction.normalized();
   const Eigen::Matrix3d keep = Eigen::Matrix3d::Identity() - u * u.transpose();
@@ -202,7 +203,8 @@ Eigen::Matrix3d without_direction(const Eigen::Matrix3d& information,
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(information, Eigen::EigenvaluesOnly)
           .eigenvalues()
           .maxCoeff();
-  const Eigen::Matrix3d out = held + 1e-6 * largest * u * u.transpose();
+  const Eigen::Matrix3d out =
+      held + kept * (information - held) + 1e-6 * largest * u * u.transpose();
   return 0.5 * (out + out.transpose());
 }
 
@@ -360,6 +362,8 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error("loop closure: min_search_score must be in [0, 1]");
   if (!(options.verification.max_shifted_fraction >= 0.0))
     throw Error("loop closure: max_shifted_fraction must not be negative (0: not checked)");
+  if (!(options.sliding_information_kept >= 0.0 && options.sliding_information_kept <= 1.0))
+    throw Error("loop closure: sliding_information_kept must be in [0, 1]");
   options_.search_every = std::max<std::size_t>(options_.search_every, 1);
 }
 
@@ -520,7 +524,9 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     loop.sliding = v.sliding;
     loop.slide_direction = v.slide_direction;
     Eigen::Matrix3d information = loop_information(v.hessian);
-    if (v.sliding) information = without_direction(information, v.slide_direction);
+    if (v.sliding)
+      information =
+          weakened_along(information, v.slide_direction, options_.sliding_information_kept);
     graph_.add_loop(loop, information);
   }
   return stale;

@@ -435,6 +435,8 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
     "the candidate's neighbours within this many keyframes join it for verification");
   v("hessian_loop_information", o.hessian_loop_information, nullptr,
     "loop edges' information shaped by the match's Hessian (false: diagonal sigmas)");
+  v("sliding_information_kept", o.sliding_information_kept, nullptr,
+    "share of a sliding loop's information kept along its open direction (0: none)");
   v("proximity_radius", o.proximity_radius, nullptr,
     "Candidates within this distance in the current estimate, m");
   v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
