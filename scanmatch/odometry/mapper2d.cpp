@@ -143,7 +143,8 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   try {
     Registration2DResult r = register_scans(current, reference, config_.registration, guess);
     const Registration2DOptions& o = config_.registration;
-    if (o.search_window > 0.0 && config_.wide_search_angle > o.search_angle) {
+    const bool wide = config_.wide_search_angle > o.search_angle;
+    if (o.search_window > 0.0 && (wide || config_.full_turn_search_below > 0.0)) {
       // A turn beyond the search's angle window leaves most points off the reference.
       const ScanFit fit(reference, o.search_fill_gap);
       double best = fit(current, r.transform);
@@ -158,9 +159,10 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
         best = fitted;
         return true;
       };
-      if (best < config_.wide_search_below) search_wider(config_.wide_search_angle);
+      if (wide && best < config_.wide_search_below) search_wider(config_.wide_search_angle);
       stats_.weak_fit = best < config_.full_turn_search_below;
-      if (stats_.weak_fit && config_.wide_search_angle < M_PI) whole_turn = search_wider(M_PI);
+      if (stats_.weak_fit && std::max(o.search_angle, config_.wide_search_angle) < M_PI)
+        whole_turn = search_wider(M_PI);
     }
     if (config_.constant_velocity && config_.open_step_window > 0.0)
       r.transform = prior_along_open_direction(current, reference, r.transform, guess);

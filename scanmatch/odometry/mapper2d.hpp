@@ -44,8 +44,9 @@ struct Mapper2DConfig {
   /// Only when fewer than this share of the points fit after the first search (1: always; lower
   /// values save time but miss 90-degree errors, whose walls fit).
   double wide_search_below = 1.0;
-  /// Where even the best of those leaves fewer than this share of the points fitting, the search
-  /// runs once more over the whole turn (+- 180 degrees) and wins by the same 5 %: at 1 Hz a robot
+  /// With the correlative search on, where even the best of those leaves fewer than this share of
+  /// the points fitting, the step is weak (Scan2DStats::weak_fit) and the search runs once more
+  /// over the whole turn (+- 180 degrees), winning by the same 5 %: at 1 Hz a robot
   /// turns a corner of 90 degrees between two scans, and after such a turn the constant-velocity
   /// guess expects another, so the truth lies beyond +- 90 degrees of the guess (corridor-2d
   /// over 800 scans). On the Radish logs such steps are 1-9 % of the scans and the whole turn
