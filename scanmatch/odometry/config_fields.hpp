@@ -427,7 +427,8 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("rotation_open_sigma_theta", o.rotation_open_sigma_theta, nullptr,
     "... its odometry edge's rotation standard deviation, rad");
   v("rotation_open_min_turn", o.rotation_open_min_turn, nullptr,
-    "... tested only where the step turns at least this much, rad");
+    "... tested where the step turns at least this much (and where the odometry's fit was weak), "
+    "rad");
   v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
   v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
