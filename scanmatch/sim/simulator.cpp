@@ -94,10 +94,9 @@ Simulator::Simulator(const SimOptions& options)
   const Ground* ground = world_.scene.ground();
   const double height = sensor_height(*preset_);
   if (options.trajectory || !options.trajectory_file.empty()) {
+    const Eigen::Vector2d at = world_.replay_start.value_or(world_.loop.front());
     const Pose start = from_xyz_rpy(
-        world_.loop.front().x(), world_.loop.front().y(),
-        height + (ground ? ground->height(world_.loop.front().x(), world_.loop.front().y()) : 0.0),
-        0, 0, 0);
+        at.x(), at.y(), height + (ground ? ground->height(at.x(), at.y()) : 0.0), 0, 0, 0);
     motion_ =
         replay(options.trajectory ? *options.trajectory : read_trajectory(options.trajectory_file),
                start, sensor_->rate_hz);

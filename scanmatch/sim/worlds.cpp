@@ -1,5 +1,6 @@
 #include "scanmatch/sim/worlds.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +35,51 @@ void wall_with_doors(Scene& scene, Eigen::Vector2d a, Eigen::Vector2d b,
     start = centre + 0.5 * width;
   }
   if (length > start + 0.05) wall(scene, a + start * u, b, z0, z1);
+}
+
+// A closed path through `corners` (in order): straight between them, turning on arcs of `radius`
+// (tighter where a side is too short for it), starting where the side from corners[0] to
+// corners[1] leaves its arc, as waypoints `spacing` apart. The simulator's Catmull-Rom path
+// overshoots where neighbouring waypoints are unevenly spaced: through a rectangle's four corners
+// alone it bulged 10-15 m off the sides, through furniture and buildings.
+std::vector<Eigen::Vector2d> rounded_loop(const std::vector<Eigen::Vector2d>& corners,
+                                          double radius, double spacing) {
+  const std::size_t n = corners.size();
+  std::vector<Eigen::Vector2d> fine;  // arcs only: the sides are the gaps between them
+  std::size_t first_side = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& previous = corners[(i + n - 1) % n];
+    const Eigen::Vector2d& corner = corners[i];
+    const Eigen::Vector2d& next = corners[(i + 1) % n];
+    const Eigen::Vector2d in = (corner - previous).normalized(), out = (next - corner).normalized();
+    const double turn = std::atan2(in.x() * out.y() - in.y() * out.x(), in.dot(out));  // left > 0
+    const double half_turn_tan = std::tan(0.5 * std::abs(turn));
+    const double shortest_half = 0.5 * std::min((corner - previous).norm(), (next - corner).norm());
+    const double r = std::min(radius, shortest_half / std::max(half_turn_tan, 1e-9));
+    const Eigen::Vector2d start = corner - r * half_turn_tan * in;
+    const Eigen::Vector2d centre = start + (turn >= 0 ? r : -r) * Eigen::Vector2d(-in.y(), in.x());
+    const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(turn) * r / 0.05)));
+    for (int k = 0; k <= steps; ++k)
+      fine.push_back(centre + Eigen::Rotation2Dd(turn * k / steps) * (start - centre));
+    if (i == 0) first_side = fine.size() - 1;
+  }
+  std::rotate(fine.begin(), fine.begin() + static_cast<long>(first_side), fine.end());
+  fine.push_back(fine.front());
+  double perimeter = 0.0;
+  for (std::size_t i = 1; i < fine.size(); ++i) perimeter += (fine[i] - fine[i - 1]).norm();
+  const auto count = static_cast<std::size_t>(std::max(3.0, std::round(perimeter / spacing)));
+  const double step = perimeter / static_cast<double>(count);
+  std::vector<Eigen::Vector2d> points{fine.front()};
+  double travelled = 0.0;  // along `fine` up to point i - 1
+  for (std::size_t i = 1; i < fine.size() && points.size() < count; ++i) {
+    const double length = (fine[i] - fine[i - 1]).norm();
+    while (points.size() < count && step * static_cast<double>(points.size()) < travelled + length)
+      points.push_back(fine[i - 1] +
+                       (fine[i] - fine[i - 1]) *
+                           ((step * static_cast<double>(points.size()) - travelled) / length));
+    travelled += length;
+  }
+  return points;
 }
 
 void box_at(Scene& scene, double x, double y, double z0, Eigen::Vector3d size, double yaw,
@@ -144,9 +190,12 @@ World make_campus(std::uint64_t seed) {
   ground.cell = 2;
   s.set_ground(ground);
   const auto gz = [&](double x, double y) { return ground.height(x, y); };
-  // Road loop: rectangle with corners (+-60, +-40); road half-width 4 m, kerbs at 4.5 m.
+  // Road loop: rectangle with corners (+-60, +-40); road half-width 4 m, kerbs at 4.5 m. Drives
+  // follow the roads' centre lines and turn on 12 m arcs, which stay inside the crossings (3.5 m
+  // in from either centre line at the apex) and end before the roadside objects begin.
   const double rx = 60, ry = 40;
-  w.loop = {{-rx, -ry}, {rx, -ry}, {rx, ry}, {-rx, ry}};
+  w.loop = rounded_loop({{-rx, -ry}, {rx, -ry}, {rx, ry}, {-rx, ry}}, 12.0, 2.0);
+  w.replay_start = Eigen::Vector2d(-rx, -ry);  // the crossing, where replays always began
   w.still_position = Eigen::Vector3d(-20, -ry + 1.5, 0.2);
   // Kerbs on both sides of each straight road, as short segments following the ground.
   const auto kerb_line = [&](Eigen::Vector2d a, Eigen::Vector2d b) {

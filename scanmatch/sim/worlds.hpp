@@ -2,6 +2,7 @@
 // Procedural scenes and the paths through their free space.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "scanmatch/sim/scene.hpp"
@@ -12,6 +13,8 @@ struct World {
   Scene scene;
   std::vector<Eigen::Vector2d> loop;  ///< closed path through free space
   Eigen::Vector3d still_position;     ///< where still presets stand (x, y, yaw)
+  /// Where a replayed trajectory starts (heading +x); the loop's start when not set.
+  std::optional<Eigen::Vector2d> replay_start;
 };
 
 /// Office floor: a lobby and an end hall with desks, pillars and cabinets, joined by a straight
