@@ -55,13 +55,17 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   result.condition_number = plain.condition_number;
   result.registered = plain.inliers >= kMinimumFramePoints;
   if (result.registered) result.motion = plain.transform;
-  if (prior.uncertain)  // first frames, irregular steps: check other starts
-    result.motion =
-        best_start(source, result.motion, prior.motion, result.iterations, result.recovered);
+  // A certain prior whose solve was slow to settle may have stopped in a ripple of the grid.
+  const bool slow =
+      config_.wide_start_iterations > 0 && plain.iterations >= config_.wide_start_iterations;
+  if (prior.uncertain || slow)
+    result.motion = best_start(source, result.motion, prior.motion, prior.uncertain,
+                               result.iterations, result.recovered);
   return result;
 }
 
-std::vector<Pose> CoarseNdt::other_starts(const Pose& prior_motion) const {
+std::vector<Pose> CoarseNdt::other_starts(const Pose& prior_motion, bool uncertain) const {
+  if (!uncertain) return {prior_motion};
   std::vector<Pose> starts = {prior_motion, Pose(Pose::Identity()),
                               scaled_motion(prior_motion, 0.5), scaled_motion(prior_motion, 2.0)};
   // About the sensor's z axis: sensors are mounted upright, and hand-held ones sweep mostly about
@@ -79,8 +83,8 @@ std::vector<Pose> CoarseNdt::other_starts(const Pose& prior_motion) const {
 }
 
 Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                           int& iterations, bool& recovered) const {
-  if (!config_.uncertain_starts || reference_.empty()) return plain;
+                           bool uncertain, int& iterations, bool& recovered) const {
+  if ((uncertain && !config_.uncertain_starts) || reference_.empty()) return plain;
   const double outliers = config_.registration.ndt_outlier_ratio;
   const NdtFactor normal = ndt_factor(source, grid_, config_.ndt_neighbours, outliers);
   const auto score = [&](const Pose& motion, std::size_t& inliers) {
@@ -92,13 +96,17 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
   double best_cost = score(plain, inliers);
   Pose best = plain;
 
-  // The wider grid of the reference frame: a basin a few times the normal one.
-  GaussianVoxelMap wide(grid_options(config_.ndt_resolution * config_.uncertain_ndt_scale));
-  wide.insert(reference_);
-  const NdtFactor widened_factor = ndt_factor(source, wide, config_.ndt_neighbours, outliers);
+  // The wider grid of the reference frame: a basin a few times the normal one. Built once per
+  // reference, on first use.
+  if (!wide_grid_) {
+    wide_grid_.emplace(grid_options(config_.ndt_resolution * config_.uncertain_ndt_scale));
+    wide_grid_->insert(reference_);
+  }
+  const NdtFactor widened_factor =
+      ndt_factor(source, *wide_grid_, config_.ndt_neighbours, outliers);
 
   std::vector<Pose> tried;
-  for (const Pose& start : other_starts(prior_motion)) {
+  for (const Pose& start : other_starts(prior_motion, uncertain)) {
     bool seen = false;
     for (const Pose& t : tried) seen = seen || near(t, start);
     if (seen) continue;
@@ -123,7 +131,10 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
 void CoarseNdt::set_reference(PointCloud frame, bool bridged) {
   grid_.clear();
   grid_.insert(frame);
-  if (!frame.empty() || !bridged) reference_ = std::move(frame);
+  if (!frame.empty() || !bridged) {
+    reference_ = std::move(frame);
+    wide_grid_.reset();
+  }
 }
 
 }  // namespace scanmatch

@@ -10,6 +10,7 @@
 // the start whose result scores best on the normal grid (by a margin) wins.
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
@@ -45,14 +46,16 @@ class CoarseNdt {
   /// The best motion among `plain` and the other starts (adds their iterations; `recovered`
   /// when another start won).
   Pose best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                  int& iterations, bool& recovered) const;
-  /// The other starts of an uncertain prior, `prior_motion` first.
-  std::vector<Pose> other_starts(const Pose& prior_motion) const;
+                  bool uncertain, int& iterations, bool& recovered) const;
+  /// The starts to try, `prior_motion` first: only it for a certain prior (wide_prior_start).
+  std::vector<Pose> other_starts(const Pose& prior_motion, bool uncertain) const;
 
   OdometryConfig config_;
   SolverOptions solver_;
   GaussianVoxelMap grid_;  ///< the reference frame's NDT grid, in its sensor frame
   PointCloud reference_;
+  /// reference_'s grid uncertain_ndt_scale times wider, built on first use by best_start.
+  mutable std::optional<GaussianVoxelMap> wide_grid_;
 };
 
 }  // namespace scanmatch

@@ -155,6 +155,9 @@ void describe(OdometryConfig& c, Visitor& v) {
     "ctf-icp: angle between turned starts, rad");
   v("uncertain_ndt_scale", c.uncertain_ndt_scale, nullptr,
     "ctf-icp: those starts run first on an NDT grid this many times ndt_resolution");
+  v("wide_start_iterations", c.wide_start_iterations, nullptr,
+    "ctf-icp: a certain prior whose NDT solve took this many iterations also starts on the wider "
+    "grid (uncertain_ndt_scale), kept when it scores better (0: never)");
   v("uncertain_jump_scale", c.uncertain_jump_scale, nullptr,
     "max_jump and max_jump_angle widen by this factor under an uncertain prior");
   v("min_downsampled_points", c.min_downsampled_points, nullptr,

@@ -40,6 +40,8 @@ void check_odometry_config(const OdometryConfig& c) {
         "pi) and rotation_starts within 0..18");
   if (!(c.uncertain_ndt_scale >= 1.0) || !(c.uncertain_jump_scale >= 1.0))
     throw Error("odometry: uncertain_ndt_scale and uncertain_jump_scale must be at least 1");
+  if (c.wide_start_iterations < 0)
+    throw Error("odometry: wide_start_iterations must not be negative (0: never)");
   positive(c.prior_miss_distance, "prior_miss_distance");
   positive(c.prior_miss_angle, "prior_miss_angle");
 }

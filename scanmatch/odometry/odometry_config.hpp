@@ -73,7 +73,13 @@ struct OdometryConfig {
   int rotation_starts = 2;              ///< turned starts per side (0: none)
   double rotation_start_step = 0.0873;  ///< rad (5 deg)
   double uncertain_ndt_scale = 3.0;     ///< the other starts run first on this times ndt_resolution
-  double uncertain_jump_scale = 3.0;    ///< max_jump and max_jump_angle widen by this factor
+  /// ctf-icp: a certain prior whose NDT solve took at least this many iterations is also
+  /// registered first on the wider grid (uncertain_ndt_scale), then on the normal one, and that
+  /// result kept when it scores better (0: never). The normal grid's basin along a surface is
+  /// about a cell: on ground seen from low down the score ripples with the cells, and a prior
+  /// 0.5 m or a few degrees off (a car entering a turn) stops in a ripple, slowly.
+  int wide_start_iterations = 15;
+  double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
   std::uint32_t min_downsampled_points = 1000;
