@@ -188,10 +188,11 @@ TEST(Keyframes, AviaKeyframesWithoutPointTimeAreTracked) {
       simulate(avia("dynamic-outdoor-fast", sanitized() ? 40 : 150), fast_lio_like(0.75, 0.0));
   ASSERT_GT(k.frames.size(), sanitized() ? 15u : 60u);
   const AteResult ate = track(k);
-  // Measured 3.8 % of the path since the campus drives follow the roads (2026-11-26): keyframes
-  // 2-4 look straight down the road from a one-frame map (4-5 degenerate directions, 1-9 % of
-  // the points paired) and keep 0.6-0.96 m of their ~0.9 m steps. On the old path, which turned
-  // across the block from the start, 0.079 %. What is left to do: docs/odometry.md.
+  // Measured 2.7 % of the path since the campus drives follow the roads (2026-11-26; 3.8 % before
+  // the wide start of slow solves): keyframes 2-3 look straight down the road from a one-frame
+  // map while the robot speeds up, and their coarse solves stop in a ripple of the NDT grid
+  // 0.8-0.96 m short of their ~0.9 m steps. On the old path, which turned across the block from
+  // the start, 0.079 %. What is left to do: docs/odometry.md, "A prior that stops in a ripple".
   const AteResult without = track(k, without_adaptive_rules());
   std::printf("[ avia keyframes ] ATE %.3f %% (without the adaptive rules %.3f %%)\n",
               ate.rmse_percent_of_path, without.rmse_percent_of_path);
