@@ -7,7 +7,9 @@
 // twice the prior, and the prior turned about the sensor's z axis by +-k * rotation_start_step
 // (a hand-held sweep that reverses leaves the constant-velocity rotation several degrees off, out
 // of NDT's basin), each first on a grid uncertain_ndt_scale times wider, then on the normal grid;
-// the start whose result scores best on the normal grid (by a margin) wins.
+// the start whose result scores best on the normal grid (by a margin) wins. A certain prior whose
+// solve took wide_start_iterations or more (slow: it may have stopped in a ripple of the grid, as
+// when a car enters a turn) gets the prior itself as the one other start.
 
 #include <cstddef>
 #include <optional>
@@ -47,14 +49,15 @@ class CoarseNdt {
   /// when another start won).
   Pose best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
                   bool uncertain, int& iterations, bool& recovered) const;
-  /// The starts to try, `prior_motion` first: only it for a certain prior (wide_prior_start).
+  /// The starts to try, `prior_motion` first: only it for a certain prior.
   std::vector<Pose> other_starts(const Pose& prior_motion, bool uncertain) const;
 
   OdometryConfig config_;
   SolverOptions solver_;
   GaussianVoxelMap grid_;  ///< the reference frame's NDT grid, in its sensor frame
   PointCloud reference_;
-  /// reference_'s grid uncertain_ndt_scale times wider, built on first use by best_start.
+  /// reference_'s grid uncertain_ndt_scale times wider, built on first use by best_start (so
+  /// align() is not safe to call from two threads at once on one CoarseNdt).
   mutable std::optional<GaussianVoxelMap> wide_grid_;
 };
 
