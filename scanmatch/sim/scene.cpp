@@ -173,28 +173,40 @@ RayHit Scene::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
   return out;
 }
 
+namespace {
+// Signed distances (negative inside), exact for boxes and cylinders, approximate for ellipsoids
+// other than spheres.
+double signed_distance(const Box& b, const Eigen::Vector3d& p) {
+  Eigen::Vector3d local;
+  local.head<2>() = yaw_rotation(b.yaw).transpose() * (p.head<2>() - b.center.head<2>());
+  local.z() = p.z() - b.center.z();
+  const Eigen::Vector3d q = local.cwiseAbs() - b.half_size;
+  return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+}
+double signed_distance(const Cylinder& c, const Eigen::Vector3d& p) {
+  const double radial = (p.head<2>() - c.center).norm() - c.radius;
+  const double vertical = std::max(c.z_min - p.z(), p.z() - c.z_max);
+  const Eigen::Vector2d q(radial, vertical);
+  return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+}
+double signed_distance(const Ellipsoid& e, const Eigen::Vector3d& p) {
+  return (((p - e.center).cwiseQuotient(e.radii)).norm() - 1.0) * e.radii.minCoeff();
+}
+}  // namespace
+
+double Scene::distance_to_objects(const Eigen::Vector3d& p) const {
+  double best = std::numeric_limits<double>::max();
+  for (const Box& b : boxes_) best = std::min(best, signed_distance(b, p));
+  for (const Cylinder& c : cylinders_) best = std::min(best, signed_distance(c, p));
+  for (const Ellipsoid& e : ellipsoids_) best = std::min(best, signed_distance(e, p));
+  return best;
+}
+
 double Scene::distance_to_surface(const Eigen::Vector3d& p) const {
   double best = std::numeric_limits<double>::max();
-  for (const Box& b : boxes_) {
-    const Eigen::Matrix2d R = yaw_rotation(b.yaw);
-    Eigen::Vector3d local;
-    local.head<2>() = R.transpose() * (p.head<2>() - b.center.head<2>());
-    local.z() = p.z() - b.center.z();
-    const Eigen::Vector3d q = local.cwiseAbs() - b.half_size;
-    const double outside = q.cwiseMax(0.0).norm();
-    const double inside = std::min(q.maxCoeff(), 0.0);
-    best = std::min(best, std::abs(outside + inside));
-  }
-  for (const Cylinder& c : cylinders_) {
-    const double radial = (p.head<2>() - c.center).norm() - c.radius;
-    const double vertical = std::max(c.z_min - p.z(), p.z() - c.z_max);
-    const Eigen::Vector2d q(radial, vertical);
-    best = std::min(best, std::abs(q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0)));
-  }
-  for (const Ellipsoid& e : ellipsoids_) {
-    const double k = ((p - e.center).cwiseQuotient(e.radii)).norm();
-    best = std::min(best, std::abs(k - 1.0) * e.radii.minCoeff());
-  }
+  for (const Box& b : boxes_) best = std::min(best, std::abs(signed_distance(b, p)));
+  for (const Cylinder& c : cylinders_) best = std::min(best, std::abs(signed_distance(c, p)));
+  for (const Ellipsoid& e : ellipsoids_) best = std::min(best, std::abs(signed_distance(e, p)));
   if (has_ground_ && std::abs(p.x()) <= ground_.half_extent &&
       std::abs(p.y()) <= ground_.half_extent) {
     // Height of the triangulated surface (what the rays hit), not of the analytic one.

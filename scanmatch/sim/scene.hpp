@@ -59,6 +59,9 @@ class Scene {
   /// Distance from p to the nearest exact surface (boxes, cylinders, ellipsoids (approximate
   /// for non-spheres), ground); for tests of point consistency.
   double distance_to_surface(const Eigen::Vector3d& p) const;
+  /// Signed distance from p to the nearest box, cylinder or ellipsoid (negative inside one; the
+  /// ground left out): where a sensor may not be.
+  double distance_to_objects(const Eigen::Vector3d& p) const;
 
   const std::vector<Box>& boxes() const { return boxes_; }
   const std::vector<Cylinder>& cylinders() const { return cylinders_; }
