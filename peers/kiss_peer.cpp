@@ -80,8 +80,8 @@ class KissOdometry final : public FrameOdometry {
   }
 
   const FrameStats& last_stats() const override { return stats_; }
-  const PointCloud* last_map_frame(Pose& world_from_frame) const override {
-    world_from_frame = end_pose_;  // the deskewed points are in the sweep-end frame
+  const PointCloud* last_map_frame(Pose& registration_from_frame) const override {
+    registration_from_frame = end_pose_;  // the deskewed points, in the sweep-end frame
     return &last_frame_;
   }
 

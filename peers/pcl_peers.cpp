@@ -81,8 +81,8 @@ class PclOdometry final : public FrameOdometry {
   }
 
   const FrameStats& last_stats() const override { return stats_; }
-  const PointCloud* last_map_frame(Pose& world_from_frame) const override {
-    world_from_frame = previous_pose_;
+  const PointCloud* last_map_frame(Pose& registration_from_frame) const override {
+    registration_from_frame = previous_pose_;
     return &previous_frame_;
   }
 

@@ -64,6 +64,7 @@ OdometryConfig without_adaptive_rules() {
   c.wide_start_iterations = 0;
   c.uncertain_jump_scale = 1.0;
   c.min_downsampled_points = 0;
+  c.redeskew_translation = c.redeskew_rotation = 0.0;
   return c;
 }
 

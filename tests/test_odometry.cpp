@@ -142,6 +142,69 @@ TEST(Odometry, DeskewingImprovesAFastRotatingHandHeldSequence) {
   EXPECT_LT(with.ate.rmse, without.ate.rmse);
 }
 
+OdometryConfig without_redeskew() {
+  OdometryConfig c = with_method("ctf-icp");
+  c.redeskew_translation = 0.0;
+  c.redeskew_rotation = 0.0;
+  return c;
+}
+
+TEST(Odometry, AFrameWhosePriorMissedItsTurnIsDeskewedAgain) {
+  // handheld-fast's turn rate changes by up to 10 deg from one frame to the next: deskewed by the
+  // constant-velocity prior, a frame keeps that much of its distortion, and so does the map.
+  const Sequence& s = simulated("handheld-fast", sanitized() ? 30 : 100);
+  const std::size_t n = s.frames.size();
+  Odometry odometry(with_method("ctf-icp"));
+  std::vector<Pose> poses;
+  std::size_t redeskewed = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    poses.push_back(odometry.register_frame(s.frames[i], s.times[i]));
+    redeskewed += odometry.last_stats().redeskewed;
+  }
+  EXPECT_GT(redeskewed, n / 2);
+  const OdometryRun without = run(without_redeskew(), s);
+  // The shape of the path, without the start's heading (the next test's subject).
+  const double again = compute_ate(s.truth, poses, Alignment::kSe3).rmse;
+  const double once = compute_ate(s.truth, without.poses, Alignment::kSe3).rmse;
+  EXPECT_LT(again, 0.5 * once) << again << " m against " << once << " m";
+}
+
+TEST(Odometry, AStartInTheMiddleOfASlowingTurnKeepsItsHeading) {
+  // Frame 0 starts turning at 250 deg/s and slows by 500 deg/s^2 (steps of 22.5, 17.5, 12.5 ...
+  // deg) while moving at 0.5 m/s. The first two frames have no measured velocity to deskew them
+  // by, and the world (frame 0's start) lies half of frame 0's turn before its middle.
+  Trajectory turn;
+  for (int i = 0; i <= 60; ++i) {
+    const double t = 0.05 * i;
+    const double yaw = (250.0 * t - 0.5 * 500.0 * t * t) / kDegreesPerRadian;
+    Pose p = Pose::Identity();
+    p.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    p.translation() = Eigen::Vector3d(0.5 * t, 0, 0);
+    turn.poses.push_back(p);
+    turn.timestamps.push_back(t);
+  }
+  sim::SimOptions o;
+  o.preset = "handheld-fast";
+  o.trajectory = turn;
+  o.frames = sanitized() ? 10 : 25;
+  const sim::Simulator simulator(o);
+  Sequence s;
+  for (std::size_t i = 0; i < simulator.size(); ++i) {
+    s.frames.push_back(simulator.frame(i));
+    s.times.push_back(simulator.frame_time(i));
+  }
+  s.truth = simulator.ground_truth().poses;
+  const auto worst_heading_error = [&](const OdometryRun& r) {
+    double worst = 0.0;
+    for (std::size_t i = 2; i < r.poses.size(); ++i)
+      worst = std::max(worst, rotation_angle(s.truth[i].inverse() * r.poses[i]));
+    return worst * kDegreesPerRadian;
+  };
+  // Measured 0.75 deg; deskewing only from frame 2 on left the whole run ~6 deg off.
+  EXPECT_LT(worst_heading_error(run(with_method("ctf-icp"), s)), 1.5);
+  EXPECT_GT(worst_heading_error(run(without_redeskew(), s)), 3.0);
+}
+
 TEST(Odometry, MapMemoryStaysFlatWithASmallRadius) {
   const Sequence& s = simulated("dynamic-outdoor-fast", 300);
   OdometryConfig c = with_method("ctf-icp");

@@ -74,13 +74,13 @@ TEST(Peers, OurOdometryThroughTheInterfaceGivesTheSamePoses) {
       ASSERT_TRUE(a.isApprox(b, 0.0)) << method << " frame " << i;
       ASSERT_EQ(direct.last_stats().points_downsampled, through->last_stats().points_downsampled);
     }
-    Pose world_from_frame;
-    const PointCloud* last = through->last_map_frame(world_from_frame);
+    Pose registration_from_frame;
+    const PointCloud* last = through->last_map_frame(registration_from_frame);
     ASSERT_NE(last, nullptr);
     const OdometryPipeline& pipeline = direct.pipeline();
     EXPECT_EQ(last->size(), pipeline.last_frame().size());
-    EXPECT_TRUE(
-        world_from_frame.isApprox(pipeline.world_from_internal() * pipeline.last_internal_pose()));
+    EXPECT_TRUE(registration_from_frame.isApprox(pipeline.last_internal_pose()));
+    EXPECT_TRUE(through->world_from_registration().isApprox(pipeline.world_from_internal()));
   }
 }
 

@@ -135,6 +135,10 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("deskew", c.deskew, "--no-deskew", "Do not correct motion distortion");
   v("deskew_min_translation", c.deskew_min_translation, nullptr, "deskew dead band, m per frame");
   v("deskew_min_rotation", c.deskew_min_rotation, nullptr, "deskew dead band, rad per frame");
+  v("redeskew_translation", c.redeskew_translation, nullptr,
+    "deskew again by the registered motion where it misses the prior by this, m per frame");
+  v("redeskew_rotation", c.redeskew_rotation, nullptr,
+    "likewise for rotation, rad per frame (both 0: never)");
   v("max_jump", c.max_jump, nullptr, "results farther from the prior are rejected, m");
   v("max_jump_angle", c.max_jump_angle, nullptr, "likewise for rotation, rad");
   v("time_scaled_prior", c.time_scaled_prior, nullptr,

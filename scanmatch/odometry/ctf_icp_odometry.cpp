@@ -5,7 +5,8 @@
 namespace scanmatch {
 
 CtfIcpOdometry::CtfIcpOdometry(const OdometryConfig& config)
-    : OdometryPipeline(config, /*keep_attributes=*/false, config.dense_sparse_map),
+    : OdometryPipeline(config, /*keep_attributes=*/false, config.dense_sparse_map,
+                       /*deskews_again=*/true),
       coarse_(config),
       fine_(config),
       map_(config),
@@ -48,6 +49,13 @@ void CtfIcpOdometry::update_reference(PointCloud frame, const PointCloud& map_po
   map_.add(map_points.empty() ? frame : map_points, pose, frames() == 0);
   coarse_.set_reference(std::move(frame), bridged);
   stats.map_ms = map_time.ms();
+}
+
+void CtfIcpOdometry::restart_reference(PointCloud first, const PointCloud& map_points) {
+  map_ = MapUpdate(config());
+  map_.add(map_points.empty() ? first : map_points, Pose::Identity(), /*first=*/true);
+  coarse_ = CoarseNdt(config());
+  coarse_.set_reference(std::move(first), /*bridged=*/false);
 }
 
 }  // namespace scanmatch

@@ -28,6 +28,7 @@ class CtfIcpOdometry final : public OdometryPipeline {
                 FrameStats& stats) override;
   void update_reference(PointCloud frame, const PointCloud& map_points, const Pose& pose,
                         bool bridged, FrameStats& stats) override;
+  void restart_reference(PointCloud first, const PointCloud& map_points) override;
 
   CoarseNdt coarse_;
   FineStage fine_;

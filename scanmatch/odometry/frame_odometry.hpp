@@ -31,8 +31,13 @@ class FrameOdometry {
   /// Timing and counts of the last frame (stages a method does not have stay 0).
   virtual const FrameStats& last_stats() const = 0;
   /// The last registered frame's points for the exported map, and the pose that places them in
-  /// the world frame; nullptr when the method keeps none.
-  virtual const PointCloud* last_map_frame(Pose& world_from_frame) const = 0;
+  /// the method's registration frame; nullptr when the method keeps none.
+  virtual const PointCloud* last_map_frame(Pose& registration_from_frame) const = 0;
+  /// Places the registration frame in the world frame of the reported poses. Identity for a method
+  /// that registers in that world; ours registers from frame 0's middle, and the world (frame 0's
+  /// start) is known from the first motions: it may move until `world_settles_after` frames.
+  virtual Pose world_from_registration() const { return Pose::Identity(); }
+  virtual std::size_t world_settles_after() const { return 0; }
 };
 
 /// Builds a peer from the run's configuration (the peer reads what applies to it: voxel_size,

@@ -31,6 +31,7 @@ struct FrameStats {
   // Health of the frame: how far to trust it.
   bool prior_uncertain = false;
   bool recovered = false;
+  bool redeskewed = false;
   double prior_miss_m = 0, prior_miss_deg = 0;
   double fine_paired_fraction = 0;
   double coarse_fine_m = 0, coarse_fine_deg = 0;
@@ -58,6 +59,9 @@ void describe(Stats& s, Visitor& v) {
   v("recovered", s.recovered,
     "ctf-icp: another coarse start (the identity, a scaled or a turned prior) scored better than "
     "the prior's own result, and replaced it");
+  v("redeskewed", s.redeskewed,
+    "the registered motion missed the prior the frame was deskewed by (redeskew_translation, "
+    "redeskew_rotation): deskewed again by it and registered again");
   v("prior_miss_m", s.prior_miss_m, "distance of the estimate from the motion prior, m");
   v("prior_miss_deg", s.prior_miss_deg, "rotation of the estimate from the motion prior, deg");
   v("fine_paired_fraction", s.fine_paired_fraction,

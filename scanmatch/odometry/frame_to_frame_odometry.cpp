@@ -16,7 +16,8 @@ RegistrationOptions registration_options(const OdometryConfig& config) {
 }  // namespace
 
 FrameToFrameOdometry::FrameToFrameOdometry(const OdometryConfig& config)
-    : OdometryPipeline(config, /*keep_attributes=*/true, /*map_points=*/false),
+    : OdometryPipeline(config, /*keep_attributes=*/true, /*map_points=*/false,
+                       /*deskews_again=*/false),
       registration_(registration_options(config)),
       minimum_points_(minimum_points(config.method, config.registration)) {}
 

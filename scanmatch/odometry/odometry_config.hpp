@@ -51,8 +51,17 @@ struct OdometryConfig {
   /// noise back into the next pose (a still sensor then drifts).
   double deskew_min_translation = 0.01;  ///< m per frame
   double deskew_min_rotation = 0.002;    ///< rad per frame
-  double max_jump = 1.0;        ///< m: a result farther than this from the prior is rejected
-  double max_jump_angle = 1.0;  ///< rad: likewise for rotation (hand-held motion turns fast)
+  /// ctf-icp (whose registration is trusted more than the prior): a frame was deskewed by its
+  /// prior; where the registered motion differs from that prior by
+  /// more than these, the frame is deskewed again by the registered motion and registered again
+  /// from its pose (a hand-held sensor's turn rate changes within a frame or two, and the prior's
+  /// distortion is then left in the map). The first two frames, which no measured velocity can
+  /// deskew, are deskewed once the first motion is measured and the reference restarted from
+  /// them. Both 0: never (and the first frames stay as they are).
+  double redeskew_translation = 0.05;  ///< m per frame
+  double redeskew_rotation = 0.0175;   ///< rad per frame (1 deg)
+  double max_jump = 1.0;               ///< m: a result farther than this from the prior is rejected
+  double max_jump_angle = 1.0;         ///< rad: likewise for rotation (hand-held motion turns fast)
   // Sparse and irregular frames (motion_model.hpp, preprocessor.hpp; docs/odometry.md "Sparse
   // keyframes").
   /// Scale the constant-velocity prior by the ratio of the frame time steps.

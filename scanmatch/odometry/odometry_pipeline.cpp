@@ -6,11 +6,12 @@
 namespace scanmatch {
 
 OdometryPipeline::OdometryPipeline(const OdometryConfig& config, bool keep_attributes,
-                                   bool map_points)
+                                   bool map_points, bool deskews_again)
     : config_(config),
       preprocessor_(preprocess_options(config, keep_attributes)),
       motion_(config),
-      wants_map_points_(map_points) {
+      wants_map_points_(map_points),
+      deskews_again_(deskews_again) {
   check_odometry_config(config);
   config_.registration.solver.num_threads = config.threads;
 }
@@ -30,16 +31,22 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   stats_.points_downsampled = down.size();
   stats_.preprocess_ms = total.ms();
 
+  const bool redeskew = deskews_again_ && config_.deskew && timed_frames_ &&
+                        (config_.redeskew_translation > 0.0 || config_.redeskew_rotation > 0.0);
+  if (frames_ == 0 && redeskew) first_frame_ = frame;
   const Pose predicted = pose_ * prior.motion;
   Pose estimate = predicted;
   if (frames_ > 0) {
     try {
       estimate = this->estimate(down, prior, predicted, stats_);
+      if (redeskew && !stats_.bridged)
+        estimate = deskew_again(frame, prior, deskew, estimate, down);
     } catch (const Error&) {
       stats_.bridged = true;  // too few points or correspondences: keep the motion prior
       estimate = predicted;
     }
   }
+  if (frames_ > 0) first_frame_ = PointCloud{};
   // Never let a failed solve poison the trajectory: a result far from the motion prior (or not
   // finite) is replaced by the prior.
   if (!motion_.within_gate(predicted, estimate)) {
@@ -63,12 +70,21 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   if (timed_frames_ && frames_ > 0) {
     const Pose& velocity = motion_.velocity();
     reported = pose_ * se3_exp(-0.5 * se3_log(velocity));
-    // The world is frame 0's start pose, which is known once the first motion is: half of it
-    // before frame 0's mid-frame pose (the internal origin). A first motion within a few times
-    // the deskew dead band is mostly the first registration's noise (a still start): anchoring by
-    // it would offset every later pose.
-    if (frames_ == 1 && motion_.moving(velocity, 3.0))
-      world_from_internal_ = se3_exp(0.5 * se3_log(velocity));
+    // The world is frame 0's start pose: half of frame 0's motion before its mid-frame pose (the
+    // internal origin). Frame 1 can only take the first measured motion (mid-frame 0 to 1) for
+    // it. A hand-held turn changes rate from one frame to the next (handheld-fast: 25 then
+    // 16.5 deg), and that half-frame error turns the whole trajectory by ~2 deg about the start;
+    // from frame 2 on the rate is extrapolated back to frame 0's first half (constant angular
+    // acceleration: 1.75 v1 - 0.75 v2). A first motion within a few times the deskew dead band
+    // is mostly the first registration's noise (a still start): anchoring by it would offset
+    // every later pose.
+    if (frames_ == 1 && motion_.moving(velocity, 3.0)) {
+      first_velocity_ = se3_log(velocity);
+      world_from_internal_ = se3_exp(0.5 * first_velocity_);
+      anchored_ = true;
+    }
+    if (frames_ == 2 && anchored_ && !stats_.bridged)
+      world_from_internal_ = se3_exp(0.5 * (1.75 * first_velocity_ - 0.75 * se3_log(velocity)));
     reported = world_from_internal_ * reported;
   }
   update_reference(std::move(down), map_points_, pose_, stats_.bridged, stats_);
@@ -77,8 +93,49 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   return orthonormalized(reported);
 }
 
-const PointCloud* OdometryPipeline::last_map_frame(Pose& world_from_frame) const {
-  world_from_frame = world_from_internal_ * pose_;
+Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& prior,
+                                    bool deskewed, const Pose& estimate, PointCloud& down) {
+  const Pose measured = orthonormalized(pose_.inverse() * estimate);
+  const bool first_motion = frames_ == 1 && !first_frame_.empty();
+  if (!motion_.moving(measured)) return estimate;
+  const Pose miss = (deskewed ? prior.motion : Pose::Identity()).inverse() * measured;
+  const bool missed = miss.translation().norm() > config_.redeskew_translation ||
+                      rotation_angle(miss) > config_.redeskew_rotation;
+  if (!first_motion && !missed) return estimate;
+  const FrameMotion frame_motion{measured, motion_.frame_period()};
+  if (first_motion) {
+    PointCloud first_map_points;
+    PointCloud first = preprocessor_.process(first_frame_, &frame_motion,
+                                             wants_map_points_ ? &first_map_points : nullptr);
+    if (first.empty()) return estimate;
+    restart_reference(std::move(first), first_map_points);
+  }
+  PointCloud again =
+      preprocessor_.process(frame, &frame_motion, wants_map_points_ ? &map_points_ : nullptr);
+  MotionPrior settled = prior;
+  settled.motion = measured;
+  settled.uncertain = false;
+  FrameStats second = stats_;
+  Pose result;
+  try {
+    result = this->estimate(again, settled, estimate, second);
+  } catch (const Error&) {
+    return estimate;
+  }
+  if (second.bridged) return estimate;  // e.g. the frame lost too many points: keep the first
+  second.coarse_ms += stats_.coarse_ms;
+  second.fine_ms += stats_.fine_ms;
+  second.iterations += stats_.iterations;
+  second.recovered = second.recovered || stats_.recovered;
+  second.redeskewed = true;
+  second.points_downsampled = again.size();
+  stats_ = second;
+  down = std::move(again);
+  return result;
+}
+
+const PointCloud* OdometryPipeline::last_map_frame(Pose& registration_from_frame) const {
+  registration_from_frame = pose_;
   return &last_frame();
 }
 

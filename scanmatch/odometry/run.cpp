@@ -246,6 +246,38 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   // pipeline reports the frame start, registers at mid-frame): the loop-closed reported pose is
   // the loop-closed registration pose followed by it.
   std::vector<Pose> reported_from_registered;
+  // A registered frame goes to the map and loop closure once the odometry's world frame is settled
+  // (world_settles_after): until then its points wait here, in the registration frame.
+  struct Unsettled {
+    std::optional<PointCloud> points;  ///< none: a bridged frame or a method that keeps none
+    Pose registration_from_frame = Pose::Identity(), reported = Pose::Identity();
+    std::size_t index = 0;
+  };
+  std::vector<Unsettled> unsettled;
+  const auto hand_out = [&](const PointCloud* points, const Pose& registration_from_frame,
+                            const Pose& reported, std::size_t index) {
+    const Pose world_from_frame = odometry->world_from_registration() * registration_from_frame;
+    if (points != nullptr && options.write_map) {
+      map.add(*points, world_from_frame);
+      if (options.map_export_radius > 0.0 && index % 50 == 0)
+        map.keep_within(reported.translation(), options.map_export_radius);
+    }
+    if (loop_closure) {
+      // A bridged frame (or a method that keeps no points) adds its pose only.
+      LoopInput in;
+      in.registered = points != nullptr ? world_from_frame : reported;
+      // A copy: *points is the odometry's and changes with the next frame.
+      if (points != nullptr) in.points.points = points->points;
+      in.to_map = points != nullptr && options.write_map;
+      reported_from_registered.push_back(in.registered.inverse() * reported);
+      loop_worker.push(std::move(in));
+    }
+  };
+  const auto hand_out_unsettled = [&] {
+    for (const Unsettled& u : unsettled)
+      hand_out(u.points ? &*u.points : nullptr, u.registration_from_frame, u.reported, u.index);
+    unsettled.clear();
+  };
   ProgressReporter progress("odometry " + config.method, total, "frames", options.quiet);
   Frame frame;
   double pipeline_ms = 0.0;
@@ -281,29 +313,25 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     }
     // A bridged frame has no registered points of its own (an empty frame leaves the previous
     // one in last_frame()); it would only add a copy or a guess to the map.
-    Pose world_from_frame;
+    Pose registration_from_frame = Pose::Identity();
     const PointCloud* map_frame = (options.write_map || loop_closure) && !s.bridged
-                                      ? odometry->last_map_frame(world_from_frame)
+                                      ? odometry->last_map_frame(registration_from_frame)
                                       : nullptr;
-    if (loop_closure) {
-      // A bridged frame (or a method that keeps no points) adds its pose only.
-      LoopInput in;
-      in.registered = map_frame != nullptr ? world_from_frame : pose;
-      // A copy: *map_frame is the odometry's and changes with the next frame.
-      if (map_frame != nullptr) in.points.points = map_frame->points;
-      in.to_map = map_frame != nullptr && options.write_map;
-      reported_from_registered.push_back(in.registered.inverse() * pose);
-      loop_worker.push(std::move(in));
-    }
-    if (map_frame != nullptr && options.write_map) {
-      map.add(*map_frame, world_from_frame);
-      if (options.map_export_radius > 0.0 && summary.frames % 50 == 0)
-        map.keep_within(pose.translation(), options.map_export_radius);
+    if (options.write_map || loop_closure) {
+      if (summary.frames + 1 < odometry->world_settles_after()) {
+        Unsettled u{std::nullopt, registration_from_frame, pose, summary.frames};
+        if (map_frame != nullptr) u.points = *map_frame;
+        unsettled.push_back(std::move(u));
+      } else {
+        hand_out_unsettled();
+        hand_out(map_frame, registration_from_frame, pose, summary.frames);
+      }
     }
     ++summary.frames;
     progress.update(summary.frames);
   }
   progress.finish();
+  hand_out_unsettled();  // a run shorter than the settling
   if (loop_closure) {
     loop_worker.finish();  // also after an interruption: the queued frames are worked
     loop_closure->finish();
