@@ -126,8 +126,12 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("fine_tolerance", c.fine_tolerance, nullptr, "ctf-icp: the fine stage's update tolerance");
   v("fine_max_flatness", c.fine_max_flatness, nullptr, "ctf-icp: flattest map voxels used");
   v("fine_kernel_distance", c.fine_kernel_distance, nullptr, "ctf-icp: Cauchy kernel distance, m");
+  v("degeneracy_guard_ratio", c.degeneracy_guard_ratio, "--degeneracy-guard-ratio",
+    "ctf-icp: no fine-stage update along directions below this scaled eigenvalue ratio (0: off)");
+  v("degeneracy_guard_frames", c.degeneracy_guard_frames, "--degeneracy-guard-frames",
+    "ctf-icp: over this many first frames the guard uses degeneracy_ratio");
   v("degeneracy_ratio", c.degeneracy_ratio, "--degeneracy-ratio",
-    "ctf-icp: eigenvalue ratio below which a direction keeps the prior (0: off)");
+    "ctf-icp: scaled eigenvalue ratio below which a direction is reported degenerate (0: never)");
   v("fine_stage", c.fine_stage, "--no-fine", "Ablation: ctf-icp's coarse NDT stage only");
   v("map_update", c.map_update, "--no-map-update",
     "Ablation: ctf-icp's fine stage against the previous frame, no global map");

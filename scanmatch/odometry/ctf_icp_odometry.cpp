@@ -28,7 +28,8 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
 
   if (fine_stage_ && map_.map().size() > 0) {
     const Stopwatch fine_time;
-    const FineResult fine = fine_.refine(frame, map_.map(), estimate);
+    const bool young_map = frames() < static_cast<std::size_t>(config().degeneracy_guard_frames);
+    const FineResult fine = fine_.refine(frame, map_.map(), estimate, young_map);
     const Pose disagreement = estimate.inverse() * fine.pose;
     stats.coarse_fine_m = disagreement.translation().norm();
     stats.coarse_fine_deg = rotation_angle(disagreement) * kDegreesPerRadian;

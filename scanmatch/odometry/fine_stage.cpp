@@ -15,7 +15,8 @@ FineStage::FineStage(const OdometryConfig& config) {
   SolverOptions& solver = options_.solver;
   solver = config.registration.solver;
   solver.num_threads = config.threads;
-  solver.degeneracy_ratio = config.degeneracy_ratio;
+  reported_degeneracy_ratio_ = config.degeneracy_ratio;
+  guard_ratio_ = config.degeneracy_guard_ratio;
   solver.kernel = RobustKernel{};
   if (config.fine_kernel_distance > 0.0) {
     // The residual is weighted by 1/eps along the normal: scale the kernel to match.
@@ -25,8 +26,9 @@ FineStage::FineStage(const OdometryConfig& config) {
 }
 
 FineResult FineStage::refine(const PointCloud& frame, const GaussianVoxelMap& map,
-                             const Pose& start) const {
+                             const Pose& start, bool young_map) const {
   CtfFineOptions options = options_;
+  options.solver.degeneracy_ratio = young_map ? reported_degeneracy_ratio_ : guard_ratio_;
   // Rotations count as the displacement they cause at the frame's own RMS range: a fixed lever
   // would call a narrow corridor's well-constrained roll degenerate.
   double sum_r2 = 0.0;
@@ -44,7 +46,7 @@ FineResult FineStage::refine(const PointCloud& frame, const GaussianVoxelMap& ma
     result.pose = fine.transform;
     result.degenerate_directions =
         analyse_degeneracy(fine.information, options.solver.degeneracy_range,
-                           options.solver.degeneracy_ratio)
+                           reported_degeneracy_ratio_)
             .directions;
   }
   return result;

@@ -25,10 +25,14 @@ class FineStage {
  public:
   explicit FineStage(const OdometryConfig& config);
   /// Registers `frame` (preprocessed, sensor frame) to `map` from the pose `start`.
-  FineResult refine(const PointCloud& frame, const GaussianVoxelMap& map, const Pose& start) const;
+  /// No update along the directions degenerate by config.degeneracy_guard_ratio, or by
+  /// config.degeneracy_ratio while the map is young (`young_map`).
+  FineResult refine(const PointCloud& frame, const GaussianVoxelMap& map, const Pose& start,
+                    bool young_map) const;
 
  private:
   CtfFineOptions options_;
+  double reported_degeneracy_ratio_ = 0.0, guard_ratio_ = 0.0;
 };
 
 }  // namespace scanmatch

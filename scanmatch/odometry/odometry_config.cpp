@@ -43,6 +43,11 @@ void check_odometry_config(const OdometryConfig& c) {
   if (c.wide_start_iterations < 0)
     throw Error("odometry: wide_start_iterations must not be negative (0: never)");
   positive(c.prior_miss_distance, "prior_miss_distance");
+  if (c.degeneracy_guard_frames < 0 || !(c.degeneracy_guard_ratio >= 0.0) ||
+      !(c.degeneracy_ratio >= 0.0))
+    throw Error(
+        "odometry: degeneracy_ratio, degeneracy_guard_ratio and degeneracy_guard_frames must not "
+        "be negative");
   if (!(c.redeskew_translation >= 0.0) || !(c.redeskew_rotation >= 0.0))
     throw Error("odometry: redeskew_translation and redeskew_rotation must not be negative");
   positive(c.prior_miss_angle, "prior_miss_angle");

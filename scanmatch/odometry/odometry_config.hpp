@@ -35,8 +35,17 @@ struct OdometryConfig {
   double fine_max_flatness = 1.0;
   /// m: plane distance where the fine stage's Cauchy kernel starts to down-weight (0: no kernel)
   double fine_kernel_distance = 0.1;
-  /// Degeneracy guard of the fine stage (SolverOptions::degeneracy_ratio; 0: off).
+  /// Directions of the fine stage's information below this share of the largest (rotations as
+  /// displacements at the frame's RMS range) are reported degenerate (timing.csv; 0: none).
   double degeneracy_ratio = 0.02;
+  /// The fine stage makes no update along directions below this ratio (Zhang et al.'s solution
+  /// remapping), keeping the coarse result there: only views that hold nothing along them (one
+  /// wall in a 70-deg field of view). A plain corridor's axis (0.005-0.02) is held better by the
+  /// map than by frame-to-frame NDT, whose result slides (docs/odometry.md, Degeneracy).
+  double degeneracy_guard_ratio = 0.005;
+  /// Over the first this-many frames the guard uses degeneracy_ratio: a map of a frame or two
+  /// cannot hold what a wider view would (a start inside a turn tilted 1.5 deg without it).
+  int degeneracy_guard_frames = 10;
   // Ablations of the paper's Table 5.
   bool fine_stage = true;  ///< false: coarse NDT only
   /// false: no global map; the fine stage registers against a map of the previous frame only.

@@ -170,8 +170,21 @@ World make_office(std::uint64_t seed) {
   // The corridor: plain walls, 36 m long.
   wall(s, {0, -1.25}, {36, -1.25}, 0, h, 0.65f);
   wall(s, {0, 1.25}, {36, 1.25}, 0, h, 0.65f);
-  w.loop = {{-9, -5}, {-9, 5},  {-3, 5},  {-2, 0.45},  {38, 0.45},  {40, 5},
-            {45, 5},  {45, -5}, {40, -5}, {38, -0.45}, {-2, -0.45}, {-3, -5}};
+  // Round each hall at y = +-4, clear of the boxes at y = +-5.5 and the pillars beside them.
+  w.loop = rounded_loop({{-9, -4},
+                         {-9, 4},
+                         {-3, 4},
+                         {-2, 0.45},
+                         {38, 0.45},
+                         {40, 4},
+                         {45, 4},
+                         {45, -4},
+                         {40, -4},
+                         {38, -0.45},
+                         {-2, -0.45},
+                         {-3, -4}},
+                        1.0, 0.5);
+  w.replay_start = Eigen::Vector2d(-9, -5);  // where replays always began
   w.still_position = Eigen::Vector3d(-6, 1.5, 0.3);
   s.commit();
   return w;
