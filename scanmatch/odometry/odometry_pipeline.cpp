@@ -102,6 +102,7 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
   const bool missed = miss.translation().norm() > config_.redeskew_translation ||
                       rotation_angle(miss) > config_.redeskew_rotation;
   if (!first_motion && !missed) return estimate;
+  const Stopwatch preprocess_time;
   const FrameMotion frame_motion{measured, motion_.frame_period()};
   if (first_motion) {
     PointCloud first_map_points;
@@ -110,8 +111,10 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
     if (first.empty()) return estimate;
     restart_reference(std::move(first), first_map_points);
   }
+  PointCloud again_map_points;
   PointCloud again =
-      preprocessor_.process(frame, &frame_motion, wants_map_points_ ? &map_points_ : nullptr);
+      preprocessor_.process(frame, &frame_motion, wants_map_points_ ? &again_map_points : nullptr);
+  const double preprocess_ms = preprocess_time.ms();
   MotionPrior settled = prior;
   settled.motion = measured;
   settled.uncertain = false;
@@ -127,10 +130,12 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
   second.fine_ms += stats_.fine_ms;
   second.iterations += stats_.iterations;
   second.recovered = second.recovered || stats_.recovered;
+  second.preprocess_ms += preprocess_ms;
   second.redeskewed = true;
   second.points_downsampled = again.size();
   stats_ = second;
   down = std::move(again);
+  map_points_ = std::move(again_map_points);
   return result;
 }
 
