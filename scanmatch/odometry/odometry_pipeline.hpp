@@ -80,8 +80,9 @@ class OdometryPipeline : public FrameOdometry {
   bool deskews_again_;
   PointCloud map_points_;  ///< the last frame at map density (reused between frames)
   Vector6d first_velocity_ = Vector6d::Zero();  ///< log of the first measured motion
-  bool anchored_ = false;   ///< world_from_internal_ was set from a moving start
-  PointCloud first_frame_;  ///< frame 0 as given, until frame 1 has deskewed it (redeskew_*)
+  bool anchored_ = false;     ///< world_from_internal_ was set from a moving start
+  double first_sweep_ = 0.0;  ///< s: frame 0's latest point time
+  PointCloud first_frame_;    ///< frame 0 as given, until frame 1 has deskewed it (redeskew_*)
   FrameStats stats_;
 };
 
