@@ -40,7 +40,8 @@ class OdometryPipeline : public FrameOdometry {
  protected:
   /// `keep_attributes`: the preprocessed frame keeps rings and intensities; `map_points`: sparse
   /// frames are also kept at map density for update_reference; `deskews_again`: the pipeline's
-  /// registration is trusted to deskew a frame again by (config redeskew_*). A registration
+  /// registration is trusted to deskew a frame again by (config redeskew_*) and to extrapolate the
+  /// world anchor from. A registration
   /// noisier than the constant-velocity prior would only add its noise to the frame (loam frame to
   /// frame on dynamic-outdoor-fast: 0.67 -> 1.16 m over 20 frames).
   OdometryPipeline(const OdometryConfig& config, bool keep_attributes, bool map_points,
