@@ -1,8 +1,5 @@
 #include "scanmatch/odometry/odometry_pipeline.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
 
@@ -25,8 +22,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   stats_.points_in = frame.size();
   if (frames_ == 0) {
     timed_frames_ = frame.has_time();
-    for (float t : frame.time)
-      if (std::isfinite(t)) first_sweep_ = std::max(first_sweep_, static_cast<double>(t));
+    first_sweep_ = latest_point_time(frame);
   }
   const MotionPrior& prior = motion_.predict(timestamp, frames_);
   // Deskew once a velocity is measured, and only above the dead band: deskewing by a velocity that

@@ -55,6 +55,13 @@ PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_att
   return o;
 }
 
+float latest_point_time(const PointCloud& frame) {
+  float latest = 0.0f;
+  for (float t : frame.time)
+    if (std::isfinite(t)) latest = std::max(latest, t);
+  return latest;
+}
+
 bool sparse_frame(std::size_t delivered, const PreprocessOptions& options) {
   return delivered < kDenseFactor * options.min_downsampled_points;
 }
@@ -67,12 +74,7 @@ PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* mot
                max2 = options_.max_range * options_.max_range;
   const bool deskew = motion != nullptr && frame.has_time();
   std::optional<Deskew> deskewing;
-  if (deskew) {
-    float max_time = 0.0f;
-    for (float t : frame.time)
-      if (std::isfinite(t)) max_time = std::max(max_time, t);
-    deskewing.emplace(*motion, max_time, 0.5 * motion->period);
-  }
+  if (deskew) deskewing.emplace(*motion, latest_point_time(frame), 0.5 * motion->period);
   const bool keep_ring = frame.has_ring() && options_.keep_attributes;
   const bool keep_intensity = frame.has_intensity() && options_.keep_attributes;
   PointCloud kept;

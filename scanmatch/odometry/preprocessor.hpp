@@ -51,6 +51,9 @@ class Preprocessor {
   PreprocessOptions options_;
 };
 
+/// The latest finite point time of `frame`, s (0 without times): how long its sweep took.
+float latest_point_time(const PointCloud& frame);
+
 /// A frame delivered with `delivered` points is sparse: fewer than 10 x min_downsampled_points.
 bool sparse_frame(std::size_t delivered, const PreprocessOptions& options);
 
