@@ -192,7 +192,9 @@ PointCloud Simulator::frame(std::size_t i) const {
     cloud.points.push_back(pattern.directions[k] * returns[k].range);
     cloud.intensity.push_back(returns[k].intensity);
     cloud.ring.push_back(pattern.rings[k]);
-    cloud.time.push_back(pattern.times[k]);
+    // Without distortion every point is measured at the frame's start: a time would claim a
+    // motion across the frame that is not in the data (and odometry would deskew by it).
+    if (options_.motion_distortion) cloud.time.push_back(pattern.times[k]);
   }
   return cloud;
 }

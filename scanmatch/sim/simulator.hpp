@@ -24,9 +24,11 @@ struct SimOptions {
   std::string sensor;                 ///< empty: the preset's sensor
   std::optional<std::size_t> frames;  ///< truncate (or extend a still preset) to this many frames
   std::uint64_t seed = 1;
-  bool motion_distortion = true;  ///< each point measured from the pose at its own time
-  bool noise = true;              ///< range noise and dropouts
-  std::string trajectory_file;    ///< replay this KITTI/TUM trajectory instead of the preset's path
+  /// Each point measured from the pose at its own time; false: every point from the frame's start
+  /// pose, and frames carry no per-point time.
+  bool motion_distortion = true;
+  bool noise = true;            ///< range noise and dropouts
+  std::string trajectory_file;  ///< replay this KITTI/TUM trajectory instead of the preset's path
   /// Replay this trajectory (anchored like trajectory_file); wins over trajectory_file.
   std::optional<Trajectory> trajectory;
 };
