@@ -2,6 +2,7 @@
 
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 #include "convert.hpp"
 #include "options.hpp"
 #include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/odometry/odometry_pipeline.hpp"
 
 namespace scanmatch::python {
 namespace {
@@ -46,6 +48,10 @@ class PyOdometry {
       pose = odometry_.register_frame(*cloud, stamp);
     }
     poses_.push_back(pose);
+    // The first frames were returned in a provisional world; poses holds them as settled since.
+    const OdometryPipeline& pipeline = odometry_.pipeline();
+    for (std::size_t i = 0; i < std::min(poses_.size(), pipeline.world_settles_after()); ++i)
+      poses_[i] = pipeline.settled_pose(i);
     timestamps_.push_back(stamp);
     stats_.push_back(odometry_.last_stats());
     return pose_to_array(pose);
@@ -116,7 +122,8 @@ points) are bridged by the motion prior (last_stats["bridged"]); NaN or infinite
 bad shapes raise ValueError.)doc")
       .def_property_readonly(
           "poses", [](const PyOdometry& o) { return poses_to_array(o.poses()); },
-          "(N, 4, 4) float64 copy of every pose returned so far")
+          "(N, 4, 4) float64 copy of every pose returned so far, the first frames' as settled "
+          "once the world anchor is (register_frame returned them in a provisional one)")
       .def_property_readonly(
           "timestamps",
           [](const PyOdometry& o) {

@@ -143,6 +143,10 @@ void describe(OdometryConfig& c, Visitor& v) {
     "deskew again by the registered motion where it misses the prior by this, m per frame");
   v("redeskew_rotation", c.redeskew_rotation, nullptr,
     "likewise for rotation, rad per frame (both 0: never)");
+  v("anchor_min_translation", c.anchor_min_translation, nullptr,
+    "the first motion's translation anchors the world (frame 0's start) above this, m per frame");
+  v("anchor_min_rotation", c.anchor_min_rotation, nullptr,
+    "likewise for its rotation, rad per frame");
   v("max_jump", c.max_jump, nullptr, "results farther from the prior are rejected, m");
   v("max_jump_angle", c.max_jump_angle, nullptr, "likewise for rotation, rad");
   v("time_scaled_prior", c.time_scaled_prior, nullptr,

@@ -26,10 +26,17 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
   stats.recovered = coarse.recovered;
   stats.coarse_ms = coarse_time.ms();
 
-  if (fine_stage_ && map_.map().size() > 0) {
+  // While the map holds frame 0 alone, it is the coarse stage's own reference seen through
+  // biased voxels: a 0.5 m voxel gets at most 4 of an axis-aligned wall's 0.25 m-downsampled
+  // points, so the ones that reach map_voxel_min_points are corners and oblique surfaces (a still
+  // MID-360's frame 1: 12 % paired, 6 mm and 0.27 deg off). Frame 1 is refined against frame 0 at
+  // map density instead.
+  const GaussianVoxelMap& target =
+      frames() == 1 && first_frame_map_ ? first_frame_map_->map() : map_.map();
+  if (fine_stage_ && target.size() > 0) {
     const Stopwatch fine_time;
     const bool young_map = frames() < static_cast<std::size_t>(config().degeneracy_guard_frames);
-    const FineResult fine = fine_.refine(frame, map_.map(), estimate, young_map);
+    const FineResult fine = fine_.refine(frame, target, estimate, young_map);
     const Pose disagreement = estimate.inverse() * fine.pose;
     stats.coarse_fine_m = disagreement.translation().norm();
     stats.coarse_fine_deg = rotation_angle(disagreement) * kDegreesPerRadian;
@@ -47,9 +54,17 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
 void CtfIcpOdometry::update_reference(PointCloud frame, const PointCloud& map_points,
                                       const Pose& pose, bool bridged, FrameStats& stats) {
   const Stopwatch map_time;
-  map_.add(map_points.empty() ? frame : map_points, pose, frames() == 0);
+  // Frames 0 and 1 build the map at once: frame 2 registers against both.
+  map_.add(map_points.empty() ? frame : map_points, pose, frames() <= 1);
+  if (frames() >= 1) first_frame_map_.reset();
   coarse_.set_reference(std::move(frame), bridged);
   stats.map_ms = map_time.ms();
+}
+
+void CtfIcpOdometry::set_first_frame_detail(PointCloud detail) {
+  if (!fine_stage_ || !config().map_update || detail.empty()) return;
+  first_frame_map_.emplace(config());
+  first_frame_map_->add(detail, Pose::Identity(), /*first=*/true);
 }
 
 void CtfIcpOdometry::restart_reference(PointCloud first, const PointCloud& map_points) {

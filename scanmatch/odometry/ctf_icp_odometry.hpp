@@ -7,6 +7,8 @@
 //   map_update.hpp    the global Gaussian map around the sensor
 // This file only chains them.
 
+#include <optional>
+
 #include "scanmatch/odometry/coarse_ndt.hpp"
 #include "scanmatch/odometry/fine_stage.hpp"
 #include "scanmatch/odometry/map_update.hpp"
@@ -29,10 +31,12 @@ class CtfIcpOdometry final : public OdometryPipeline {
   void update_reference(PointCloud frame, const PointCloud& map_points, const Pose& pose,
                         bool bridged, FrameStats& stats) override;
   void restart_reference(PointCloud first, const PointCloud& map_points) override;
+  void set_first_frame_detail(PointCloud detail) override;
 
   CoarseNdt coarse_;
   FineStage fine_;
   MapUpdate map_;
+  std::optional<MapUpdate> first_frame_map_;  ///< frame 0 at map density, for frame 1's fine stage
   bool fine_stage_;
 };
 

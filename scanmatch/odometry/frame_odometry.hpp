@@ -38,6 +38,13 @@ class FrameOdometry {
   /// start) is known from the first motions: it may move until `world_settles_after` frames.
   virtual Pose world_from_registration() const { return Pose::Identity(); }
   virtual std::size_t world_settles_after() const { return 0; }
+  /// The pose of frame `index` (< world_settles_after()) in the world as it stands now: the frames
+  /// before the world settles were returned in a provisional one.
+  virtual Pose settled_pose(std::size_t /*index*/) const { return Pose::Identity(); }
+  /// Frame 0's points as the odometry settled them (deskewed once the first motion was known),
+  /// at the registration frame's origin, until the world settles; nullptr where last_map_frame()
+  /// at frame 0 gave them as they stay.
+  virtual const PointCloud* settled_first_frame() const { return nullptr; }
 };
 
 /// Builds a peer from the run's configuration (the peer reads what applies to it: voxel_size,

@@ -48,6 +48,8 @@ void check_odometry_config(const OdometryConfig& c) {
     throw Error(
         "odometry: degeneracy_ratio, degeneracy_guard_ratio and degeneracy_guard_frames must not "
         "be negative");
+  if (!(c.anchor_min_translation >= 0.0) || !(c.anchor_min_rotation >= 0.0))
+    throw Error("odometry: anchor_min_translation and anchor_min_rotation must not be negative");
   if (!(c.redeskew_translation >= 0.0) || !(c.redeskew_rotation >= 0.0))
     throw Error("odometry: redeskew_translation and redeskew_rotation must not be negative");
   positive(c.prior_miss_angle, "prior_miss_angle");

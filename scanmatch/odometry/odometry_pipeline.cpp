@@ -1,5 +1,8 @@
 #include "scanmatch/odometry/odometry_pipeline.hpp"
 
+#include <algorithm>
+#include <string>
+
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
 
@@ -20,6 +23,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   const Stopwatch total;
   stats_ = FrameStats{};
   stats_.points_in = frame.size();
+  if (frames_ >= kWorldSettlesAfter) settled_first_frame_ = PointCloud{};
   if (frames_ == 0) {
     timed_frames_ = frame.has_time();
     first_sweep_ = latest_point_time(frame);
@@ -31,6 +35,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   const FrameMotion frame_motion{prior.motion, motion_.frame_period()};
   PointCloud down = preprocessor_.process(frame, deskew ? &frame_motion : nullptr,
                                           wants_map_points_ ? &map_points_ : nullptr);
+  if (frames_ == 0 && deskews_again_) set_first_frame_detail(frame_detail(frame, nullptr));
   stats_.points_downsampled = down.size();
   stats_.preprocess_ms = total.ms();
 
@@ -74,27 +79,30 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
     const Pose& velocity = motion_.velocity();
     reported = pose_ * se3_exp(-0.5 * se3_log(velocity));
     // The world is frame 0's start pose: half of frame 0's motion before its mid-frame pose (the
-    // internal origin). Frame 1 can only take the first measured motion (mid-frame 0 to 1) for
-    // it. A hand-held turn changes rate from one frame to the next (handheld-fast: 25 then
-    // 16.5 deg), and that half-frame error turns the whole trajectory by ~2 deg about the start;
-    // from frame 2 on the rate is extrapolated back to frame 0's first half (constant angular
-    // acceleration: 1.75 v1 - 0.75 v2), where frames follow one another (a step within 1.5
-    // sweeps): across keyframes 0.5 s apart a car speeding up is no constant acceleration
-    // (campus-os1 every 5th frame: 0.29 % of the path with the first motion, 1.85 % with the
-    // extrapolation), and for a registration trusted to deskew again (the extrapolation doubles a
-    // noisier one's error: gicp 0.255 -> 0.290 %). A first motion within a few times the deskew
-    // dead band is mostly the first registration's noise (a still start): anchoring by it would
-    // offset every later pose.
-    if (frames_ == 1 && motion_.moving(velocity, 3.0)) {
+    // internal origin). Frame 1 takes the first measured motion (mid-frame 0 to 1) for it; frame 2
+    // extrapolates the rate back to frame 0's first half (constant acceleration: 1.75 v1 -
+    // 0.75 v2; a hand-held turn slows from 25 to 16.5 deg per frame), and the runner reports
+    // frame 1 again under that (settled_pose). The extrapolation doubles the registrations' noise,
+    // so only where it can pay: where frames follow one another (a step within 1.5 sweeps: across
+    // keyframes 0.5 s apart a car speeding up is no constant acceleration, campus-os1 every 5th
+    // frame 0.29 -> 1.85 %), for a registration trusted to deskew again (gicp 0.255 -> 0.290 %),
+    // and where the motion changed by more than the dead band. Only the parts of the motion above
+    // anchor_min_* anchor the world at all (a still start's noise or a robot's jitter would turn
+    // every later pose).
+    if (frames_ == 1) {
       first_velocity_ = se3_log(velocity);
-      world_from_internal_ = se3_exp(0.5 * first_velocity_);
-      anchored_ = true;
+      anchor_rotation_ = first_velocity_.head<3>().norm() >= config_.anchor_min_rotation;
+      anchor_translation_ = first_velocity_.tail<3>().norm() >= config_.anchor_min_translation;
+      world_from_internal_ = se3_exp(0.5 * anchored_part(first_velocity_));
     }
-    if (frames_ == 2 && anchored_ && deskews_again_ && !stats_.bridged &&
-        motion_.frame_period() <= 1.5 * first_sweep_)
-      world_from_internal_ = se3_exp(0.5 * (1.75 * first_velocity_ - 0.75 * se3_log(velocity)));
-    reported = world_from_internal_ * reported;
+    if (frames_ == 2 && deskews_again_ && !stats_.bridged &&
+        motion_.frame_period() <= 1.5 * first_sweep_ &&
+        motion_.moving(se3_exp(first_velocity_).inverse() * velocity))
+      world_from_internal_ =
+          se3_exp(0.5 * anchored_part(1.75 * first_velocity_ - 0.75 * se3_log(velocity)));
   }
+  if (frames_ < kWorldSettlesAfter) early_starts_[frames_] = reported;
+  reported = world_from_internal_ * reported;
   update_reference(std::move(down), map_points_, pose_, stats_.bridged, stats_);
   ++frames_;
   stats_.total_ms = total.ms();
@@ -117,6 +125,8 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
     PointCloud first = preprocessor_.process(first_frame_, &frame_motion,
                                              wants_map_points_ ? &first_map_points : nullptr);
     if (first.empty()) return estimate;
+    set_first_frame_detail(frame_detail(first_frame_, &frame_motion));
+    settled_first_frame_ = first;
     restart_reference(std::move(first), first_map_points);
   }
   PointCloud again_map_points;
@@ -145,6 +155,28 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
   down = std::move(again);
   map_points_ = std::move(again_map_points);
   return result;
+}
+
+PointCloud OdometryPipeline::frame_detail(const PointCloud& frame,
+                                          const FrameMotion* motion) const {
+  PointCloud detail;
+  preprocessor_.process(frame, motion, &detail, /*dense_map_points=*/true);
+  return detail;
+}
+
+Vector6d OdometryPipeline::anchored_part(const Vector6d& motion) const {
+  Vector6d part = Vector6d::Zero();
+  if (anchor_rotation_) part.head<3>() = motion.head<3>();
+  if (anchor_translation_) part.tail<3>() = motion.tail<3>();
+  return part;
+}
+
+Pose OdometryPipeline::settled_pose(std::size_t index) const {
+  if (index >= std::min(frames_, kWorldSettlesAfter))
+    throw Error("settled_pose: frame " + std::to_string(index) + " is not an early frame");
+  // Frame 0's start is the world's origin, whatever the anchor says of the internal frame.
+  if (index == 0) return Pose::Identity();
+  return orthonormalized(world_from_internal_ * early_starts_[index]);
 }
 
 const PointCloud* OdometryPipeline::last_map_frame(Pose& registration_from_frame) const {

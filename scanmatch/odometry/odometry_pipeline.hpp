@@ -9,6 +9,7 @@
 // The reported pose is the frame-start pose, half the frame's motion earlier, in the world frame
 // anchored at frame 0's start.
 
+#include <array>
 #include <cstddef>
 
 #include "scanmatch/odometry/frame_odometry.hpp"
@@ -26,7 +27,11 @@ class OdometryPipeline : public FrameOdometry {
   const PointCloud* last_map_frame(Pose& registration_from_frame) const final;
   Pose world_from_registration() const final { return world_from_internal_; }
   /// The world anchor is set at frame 1 and refined at frame 2.
-  std::size_t world_settles_after() const final { return 3; }
+  std::size_t world_settles_after() const final { return kWorldSettlesAfter; }
+  Pose settled_pose(std::size_t index) const final;
+  const PointCloud* settled_first_frame() const final {
+    return settled_first_frame_.empty() ? nullptr : &settled_first_frame_;
+  }
 
   const OdometryConfig& config() const { return config_; }
   std::size_t frames() const { return frames_; }
@@ -61,6 +66,10 @@ class OdometryPipeline : public FrameOdometry {
   /// the internal origin: the first frame, deskewed once the first motion is measured.
   /// Only pipelines constructed with `deskews_again` are asked.
   virtual void restart_reference(PointCloud /*first*/, const PointCloud& /*map_points*/) {}
+  /// Frame 0 at map density (Preprocessor's map points), given before frame 0's reference is
+  /// set (again, when it is restarted): the one frame a young map holds, in more detail than its
+  /// voxels get from the registration points. Only pipelines constructed with `deskews_again`.
+  virtual void set_first_frame_detail(PointCloud /*detail*/) {}
 
  private:
   /// Deskews `frame` again by the motion registration measured, where that misses the motion it
@@ -69,6 +78,13 @@ class OdometryPipeline : public FrameOdometry {
   /// replaces `down` with the frame as registered.
   Pose deskew_again(const PointCloud& frame, const MotionPrior& prior, bool deskewed,
                     const Pose& estimate, PointCloud& down);
+
+  static constexpr std::size_t kWorldSettlesAfter = 3;
+
+  /// The parts of a motion (log) that anchor the world: those above anchor_min_* at frame 1.
+  Vector6d anchored_part(const Vector6d& motion) const;
+  /// `frame` cropped, deskewed by `motion` (when given) and filtered at map density.
+  PointCloud frame_detail(const PointCloud& frame, const FrameMotion* motion) const;
 
   OdometryConfig config_;
   Preprocessor preprocessor_;
@@ -80,10 +96,13 @@ class OdometryPipeline : public FrameOdometry {
   bool wants_map_points_;
   bool deskews_again_;
   PointCloud map_points_;  ///< the last frame at map density (reused between frames)
-  Vector6d first_velocity_ = Vector6d::Zero();  ///< log of the first measured motion
-  bool anchored_ = false;     ///< world_from_internal_ was set from a moving start
-  double first_sweep_ = 0.0;  ///< s: frame 0's latest point time
-  PointCloud first_frame_;    ///< frame 0 as given, until frame 1 has deskewed it (redeskew_*)
+  Vector6d first_velocity_ = Vector6d::Zero();                 ///< log of the first measured motion
+  bool anchor_rotation_ = false, anchor_translation_ = false;  ///< see anchored_part
+  double first_sweep_ = 0.0;                                   ///< s: frame 0's latest point time
+  PointCloud first_frame_;  ///< frame 0 as given, until frame 1 has deskewed it (redeskew_*)
+  PointCloud settled_first_frame_;  ///< frame 0 deskewed at frame 1, until the world settles
+  /// Frame-start poses of the frames before the world settles, in the internal frame.
+  std::array<Pose, kWorldSettlesAfter> early_starts_{};
   FrameStats stats_;
 };
 

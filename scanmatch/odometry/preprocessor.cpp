@@ -67,7 +67,7 @@ bool sparse_frame(std::size_t delivered, const PreprocessOptions& options) {
 }
 
 PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* motion,
-                                 PointCloud* map_points) const {
+                                 PointCloud* map_points, bool dense_map_points) const {
   if (map_points != nullptr) map_points->clear();
   if (!frame.fields_consistent()) return PointCloud{};
   const double min2 = options_.min_range * options_.min_range,
@@ -90,7 +90,7 @@ PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* mot
     if (keep_ring) kept.ring.push_back(frame.ring[i]);
     if (keep_intensity) kept.intensity.push_back(frame.intensity[i]);
   }
-  if (map_points != nullptr && sparse_frame(frame.size(), options_))
+  if (map_points != nullptr && (dense_map_points || sparse_frame(frame.size(), options_)))
     *map_points =
         options_.voxel_size > 0.0 ? voxel_downsample(kept, 0.25 * options_.voxel_size) : kept;
   return adaptive_downsample(kept, frame.size(), options_);

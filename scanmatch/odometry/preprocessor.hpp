@@ -42,9 +42,10 @@ class Preprocessor {
   /// The frame cropped, deskewed by `motion` (when given; points without a finite time stay as
   /// they are) and downsampled. Inconsistent fields (a time per point missing) give an empty cloud.
   /// `map_points`, when given, receives the same frame at map density: for a frame delivered
-  /// sparse, filtered at voxel_size / 4; empty for a dense one (its registration points serve).
+  /// sparse (or any frame with `dense_map_points`), filtered at voxel_size / 4; otherwise empty
+  /// (its registration points serve).
   PointCloud process(const PointCloud& frame, const FrameMotion* motion = nullptr,
-                     PointCloud* map_points = nullptr) const;
+                     PointCloud* map_points = nullptr, bool dense_map_points = false) const;
   const PreprocessOptions& options() const { return options_; }
 
  private:

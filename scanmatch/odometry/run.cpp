@@ -250,7 +250,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   // (world_settles_after): until then its points wait here, in the registration frame.
   struct Unsettled {
     std::optional<PointCloud> points;  ///< none: a bridged frame or a method that keeps none
-    Pose registration_from_frame = Pose::Identity(), reported = Pose::Identity();
+    Pose registration_from_frame = Pose::Identity();
     std::size_t index = 0;
   };
   std::vector<Unsettled> unsettled;
@@ -274,9 +274,31 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     }
   };
   const auto hand_out_unsettled = [&] {
-    for (const Unsettled& u : unsettled)
-      hand_out(u.points ? &*u.points : nullptr, u.registration_from_frame, u.reported, u.index);
+    for (Unsettled& u : unsettled) {
+      // Frame 0 was deskewed once the first motion was known: hand out that one.
+      const PointCloud* settled = u.index == 0 ? odometry->settled_first_frame() : nullptr;
+      if (settled != nullptr && u.points) {
+        u.points = *settled;
+        u.registration_from_frame = Pose::Identity();
+      }
+      hand_out(u.points ? &*u.points : nullptr, u.registration_from_frame, summary.poses[u.index],
+               u.index);
+    }
     unsettled.clear();
+  };
+  // The frames before the world settles were returned in a provisional world: once it settles
+  // (or the run ends first) they take their settled poses, and only then are they written.
+  std::size_t settled_poses = 0, written_poses = 0;
+  const auto settle_early_poses = [&] {
+    for (; settled_poses < summary.poses.size(); ++settled_poses)
+      if (settled_poses < odometry->world_settles_after())
+        summary.poses[settled_poses] = odometry->settled_pose(settled_poses);
+  };
+  const auto write_poses_until = [&](std::size_t end) {
+    for (; written_poses < end; ++written_poses) {
+      kitti->write(summary.poses[written_poses], summary.timestamps[written_poses]);
+      tum->write(summary.poses[written_poses], summary.timestamps[written_poses]);
+    }
   };
   ProgressReporter progress("odometry " + config.method, total, "frames", options.quiet);
   Frame frame;
@@ -306,9 +328,10 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     summary.poses.push_back(pose);
     summary.timestamps.push_back(frame.timestamp);
     summary.stats.push_back(s);
+    const bool settled = summary.frames + 1 >= odometry->world_settles_after();
+    if (settled) settle_early_poses();
     if (write) {
-      kitti->write(pose, frame.timestamp);
-      tum->write(pose, frame.timestamp);
+      if (settled) write_poses_until(summary.frames + 1);
       timing->line(timing_csv_row(summary.frames, frame.timestamp, s));
     }
     // A bridged frame has no registered points of its own (an empty frame leaves the previous
@@ -319,7 +342,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                       : nullptr;
     if (options.write_map || loop_closure) {
       if (summary.frames + 1 < odometry->world_settles_after()) {
-        Unsettled u{std::nullopt, registration_from_frame, pose, summary.frames};
+        Unsettled u{std::nullopt, registration_from_frame, summary.frames};
         if (map_frame != nullptr) u.points = *map_frame;
         unsettled.push_back(std::move(u));
       } else {
@@ -331,7 +354,9 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     progress.update(summary.frames);
   }
   progress.finish();
-  hand_out_unsettled();  // a run shorter than the settling
+  settle_early_poses();  // a run shorter than the settling
+  if (write) write_poses_until(summary.poses.size());
+  hand_out_unsettled();
   if (loop_closure) {
     loop_worker.finish();  // also after an interruption: the queued frames are worked
     loop_closure->finish();
