@@ -27,7 +27,7 @@ void add_report_command(CLI::App& app) {
   cmd->add_option("--title", o->title, "Page title")->capture_default_str();
   cmd->add_option("--frames", o->frames,
                   "The sequence the first run read (as odometry takes it): its frames, placed by "
-                  "the run's poses, make the 3D view's map when no run saved one (--save-map)");
+                  "the run's poses, make the 3D view's map (in place of a saved map.pcd)");
   cmd->add_option("--seed", o->seed, "Seed of a sim:PRESET --frames sequence")
       ->capture_default_str();
   cmd->add_option("--topic", o->topic, "Cloud topic of a bag given as --frames");

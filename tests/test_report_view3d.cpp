@@ -32,9 +32,11 @@ std::size_t count(const std::string& text, const std::string& what) {
 const std::string kChromium = "/usr/bin/chromium";
 
 // Chromium as the docs' screenshots run it (scripts/report_screenshot): headless, WebGL in
-// SwiftShader, nothing that waits on the network. `what` is "--dump-dom" or "--screenshot=PNG".
-// Returns the standard output (the DOM for --dump-dom).
-std::string run_chromium(const TempDir& dir, const std::string& page, const std::string& what) {
+// SwiftShader, nothing that waits on the network. `what` is "--dump-dom" or "--screenshot=PNG";
+// `options` go after the page's #view3d-only (e.g. "&frame=3"). Returns the standard output (the
+// DOM for --dump-dom).
+std::string run_chromium(const TempDir& dir, const std::string& page, const std::string& what,
+                         const std::string& options = "") {
   static int profiles = 0;
   const std::string out = dir.file("chromium_out.txt");
   const std::string command =
@@ -44,7 +46,7 @@ std::string run_chromium(const TempDir& dir, const std::string& page, const std:
       "--use-angle=swiftshader --enable-unsafe-swiftshader --hide-scrollbars "
       "--window-size=800,600 --user-data-dir=" +
       dir.file("profile" + std::to_string(profiles++)) + " " + what + " 'file://" + page +
-      "#view3d-only' > " + out + " 2>/dev/null";
+      "#view3d-only" + options + "' > " + out + " 2>/dev/null";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   return read_text(out);
 }
@@ -221,10 +223,18 @@ TEST(ReportView3D, PageDrawsMapTrajectoriesAndLoopsInChromium) {
   if (!std::filesystem::exists(kChromium))
     GTEST_SKIP() << "chromium not installed (scripts/bootstrap --browser): 3D view not checked";
 
-  const nlohmann::json status = page_status(run_chromium(dir, page, "--dump-dom"));
+  // Opened as a click on frame 3 would leave it.
+  const std::string dom = run_chromium(dir, page, "--dump-dom", "&frame=3");
+  const nlohmann::json status = page_status(dom);
   EXPECT_EQ(status.value("errors", nlohmann::json::array({"no status"})), nlohmann::json::array())
       << status.dump();
   ASSERT_TRUE(status.value("webgl", false)) << status.dump();
+  const auto tip = dom.find("<div id=\"view3d-tip\"");
+  ASSERT_NE(tip, std::string::npos);
+  const std::string tip_text = dom.substr(tip, dom.find("</div>", tip) - tip);
+  EXPECT_NE(tip_text.find("run (ctf-icp), frame 3\nstep error: "), std::string::npos) << tip_text;
+  EXPECT_NE(tip_text.find(" m, "), std::string::npos) << tip_text;  // against the reference
+  EXPECT_NE(tip_text.find("health: "), std::string::npos) << tip_text;
   // Every point of the saved map (within the budget), the odometry, the loop-closed poses and
   // the reference (8 poses each), both loop edges.
   EXPECT_EQ(status["points"].get<std::size_t>(), read_cloud(run + "/map.pcd").size());

@@ -368,8 +368,9 @@ std::string render_view3d(const std::vector<RunFolder>& runs,
     }
   }
 
-  // The map: the first run's saved one, else one rebuilt from frames; a map2d run's grid.
-  for (const RunFolder& run : runs) {
+  // The map: rebuilt from frames when they are given (the saved map has no intensities), else
+  // the first saved one; a map2d run's grid.
+  for (const RunFolder& run : options.frames.empty() ? runs : std::vector<RunFolder>{}) {
     for (const char* name : {"map.pcd", "map.ply"}) {
       const std::string path = run.path + "/" + name;
       if (!fs::is_regular_file(path)) continue;
@@ -385,7 +386,7 @@ std::string render_view3d(const std::vector<RunFolder>& runs,
     }
     if (!data["map"].is_null()) break;
   }
-  if (data["map"].is_null() && !options.frames.empty()) {
+  if (!options.frames.empty()) {
     const RunFolder& run = runs.front();
     const PointCloud shown =
         rebuild_map_from_frames(run, options.frames, options.sequence, options.max_points);

@@ -28,8 +28,9 @@ struct View3DOptions {
   std::string three_js_dir;
   /// Map points in the page at most (6 bytes each before base64, 8 after).
   std::size_t max_points = 1'000'000;
-  /// When no run saved a map: the sequence the first run read (a spec as `odometry` takes), from
-  /// whose frames and that run's poses the map is rebuilt. `sequence` as the run opened it.
+  /// The sequence the first run read (a spec as `odometry` takes): the map is rebuilt from its
+  /// frames and that run's poses (in place of a saved map, which has no intensities). `sequence`
+  /// as the run opened it.
   std::string frames;
   SequenceOptions sequence;
 };
@@ -48,9 +49,9 @@ PointCloud downsample_to_budget(const PointCloud& cloud, std::size_t max_points)
 PointCloud rebuild_map_from_frames(const RunFolder& run, const std::string& spec,
                                    const SequenceOptions& sequence, std::size_t max_points);
 
-/// The section (heading, view, note, scripts) for render_report. Reads map.pcd/map.ply of the
-/// first run that has one, map.pgm/map.yaml of a map2d run, or rebuilds the map from
-/// options.frames. Throws Error naming the file for an unreadable map or grid.
+/// The section (heading, view, note, scripts) for render_report. Rebuilds the map from
+/// options.frames when given, else reads map.pcd/map.ply of the first run that has one; shows
+/// map.pgm/map.yaml of a map2d run. Throws Error naming the file for an unreadable map or grid.
 std::string render_view3d(const std::vector<RunFolder>& runs,
                           const std::optional<Trajectory>& ground_truth,
                           const View3DOptions& options);

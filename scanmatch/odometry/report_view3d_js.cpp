@@ -46,8 +46,15 @@ const char* const kView3DScript = R"JS(
     var box = document.getElementById('view3d-canvas');
     var bar = document.getElementById('view3d-bar');
     var tip = document.getElementById('view3d-tip');
-    // #view3d-only: the view fills the window (screenshots); #view3d-only,VIEW starts in VIEW.
-    var hash = location.hash.split(','), only = hash[0] === '#view3d-only';
+    // #view3d-only: the view fills the window (screenshots); &view=VIEW starts in VIEW,
+    // &color=intensity colours by intensity, &frame=K shows frame K of the first run as a click
+    // would (or follows it in the follow view).
+    var args = {}, only = false;
+    location.hash.slice(1).split('&').forEach(function (token) {
+      var pair = token.split('=');
+      if (pair.length === 2) args[pair[0]] = decodeURIComponent(pair[1]);
+      else if (token === 'view3d-only') only = true;
+    });
     if (only) document.body.classList.add('view3d-only');
 
     var renderer;
@@ -162,7 +169,7 @@ const char* const kView3DScript = R"JS(
       legend.push('<span style="color:' + color + '">&#9644;</span> ' +
                   text.replace(/&/g, '&amp;').replace(/</g, '&lt;'));
     }
-    var referenceColor = grid ? '#000000' : '#f2f2f2';
+    var referenceColor = grid ? '#1060ff' : '#f2f2f2';
     if (data.reference) {
       line('reference', data.reference, referenceColor, 1, false);
       status.trajectory_vertices += data.reference.length / 3;
@@ -219,7 +226,17 @@ const char* const kView3DScript = R"JS(
     var controls = new THREE.OrbitControls(camera, renderer.domElement);
     controls.screenSpacePanning = true;
     controls.addEventListener('change', render);
-    function render() { renderer.render(scene, camera); }
+    // One frame at a time, on demand, and none while the page sets up: in software (SwiftShader)
+    // a frame of a million points takes a good part of a second.
+    var ready = false, frameRequested = false;
+    function render() {
+      if (!ready || frameRequested) return;
+      frameRequested = true;
+      requestAnimationFrame(function () {
+        frameRequested = false;
+        renderer.render(scene, camera);
+      });
+    }
     function resize() {
       if (only) box.style.height = (window.innerHeight - bar.offsetHeight) + 'px';
       renderer.setSize(box.clientWidth, box.clientHeight);
@@ -379,8 +396,18 @@ const char* const kView3DScript = R"JS(
 
     window.addEventListener('resize', resize);
     resize();
-    view(hash[1] || (grid && !mapPoints ? 'top' : 'oblique'));
-    render();
+    if (args.color === 'intensity' && intensity) {
+      modes.value = 'intensity';
+      colorBy('intensity');
+    }
+    var frame = Number(args.frame);
+    if (args.frame !== undefined && frame >= 0 && frame < frames) slider.value = frame;
+    view(args.view || (grid && !mapPoints ? 'top' : 'oblique'));
+    if (args.frame !== undefined && frame >= 0 && frame < frames && !following)
+      showFrame({pick: picks[0], k: frame}, null);
+    status.color = mapPoints ? (modes.value) : null;
+    ready = true;
+    renderer.render(scene, camera);
     // Times for the benchmark: the page up to this script, and this script (decoding, building
     // the scene, the first frame).
     renderer.getContext().finish();
