@@ -402,7 +402,7 @@ const char* const kView3DScript = R"JS(
     }
     var frame = Number(args.frame);
     if (args.frame !== undefined && frame >= 0 && frame < frames) slider.value = frame;
-    view(args.view || (grid && !mapPoints ? 'top' : 'oblique'));
+    view(args.view || (grid && !mapPoints ? 'top' : 'path'));
     if (args.frame !== undefined && frame >= 0 && frame < frames && !following)
       showFrame({pick: picks[0], k: frame}, null);
     status.color = mapPoints ? (modes.value) : null;
