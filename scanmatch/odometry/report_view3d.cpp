@@ -12,7 +12,6 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <unordered_set>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
@@ -30,20 +29,22 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Voxels a cloud occupies at edge `size` (non-finite points skipped).
+// Voxels a cloud occupies at edge `size` (non-finite points skipped): its voxel keys sorted and
+// counted once each (a sort is several times faster here than a hash set of as many keys).
 std::size_t occupied_voxels(const PointCloud& cloud, double size) {
-  std::unordered_set<std::uint64_t> seen;
-  seen.reserve(cloud.size());
+  std::vector<std::uint64_t> keys;
+  keys.reserve(cloud.size());
   const float inverse = static_cast<float>(1.0 / size);
   for (const Point& p : cloud.points) {
     if (!p.allFinite()) continue;
     const VoxelKey k = voxel_key_scaled(Eigen::Vector3f(p * inverse));
     // 21 bits per axis: a collision only merges two voxels' counts, never a point.
-    seen.insert((static_cast<std::uint64_t>(k.x & 0x1fffff) << 42) |
-                (static_cast<std::uint64_t>(k.y & 0x1fffff) << 21) |
-                static_cast<std::uint64_t>(k.z & 0x1fffff));
+    keys.push_back((static_cast<std::uint64_t>(k.x & 0x1fffff) << 42) |
+                   (static_cast<std::uint64_t>(k.y & 0x1fffff) << 21) |
+                   static_cast<std::uint64_t>(k.z & 0x1fffff));
   }
-  return seen.size();
+  std::sort(keys.begin(), keys.end());
+  return static_cast<std::size_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
 }
 
 // Every n-th point so that exactly `count` remain (count < cloud.size()).
@@ -259,8 +260,18 @@ PointCloud downsample_to_budget(const PointCloud& cloud, std::size_t max_points)
   if (max_points == 0) throw Error("downsample_to_budget: a budget of 0 points");
   if (cloud.size() <= max_points) return positions_and_intensity(cloud);
   const std::size_t slack = max_points + max_points * 3 / 10;
+  // The smallest edge within a factor 1.19 whose voxels fit the slack: doubling from 2 cm until
+  // they fit, then halving the last factor of two (in log scale) three times.
   double size = 0.02;
-  while (occupied_voxels(cloud, size) > slack) size *= 1.25;
+  if (occupied_voxels(cloud, size) > slack) {
+    double too_small = size;
+    size *= 2;
+    while (occupied_voxels(cloud, size) > slack) too_small = size, size *= 2;
+    for (int step = 0; step < 3; ++step) {
+      const double middle = std::sqrt(too_small * size);
+      (occupied_voxels(cloud, middle) > slack ? too_small : size) = middle;
+    }
+  }
   PointCloud voxels =
       positions_and_intensity(voxel_downsample(cloud, size, VoxelReduction::kNearestToCentroid));
   return voxels.size() <= max_points ? voxels : pick_evenly(voxels, max_points);

@@ -36,7 +36,7 @@ struct View3DOptions {
 };
 
 /// At most `max_points` of `cloud`, spread evenly over it: a voxel grid at the smallest edge
-/// (from 2 cm, growing by a quarter) that leaves at most 1.3 x max_points voxels, then every
+/// (from 2 cm, to within a factor 1.19) that leaves at most 1.3 x max_points voxels, then every
 /// n-th of those. Intensities (when present) follow their points. A cloud within the budget is
 /// returned as is.
 PointCloud downsample_to_budget(const PointCloud& cloud, std::size_t max_points);
