@@ -175,6 +175,9 @@ TEST(ReportView3D, BudgetKeepsPointsSpreadAndTheirIntensities) {
       floor.intensity.push_back(0.05f * i);
     }
   EXPECT_EQ(downsample_to_budget(floor, 40000).size(), 40000u);  // within budget: as is
+  PointCloud with_nan = floor;
+  with_nan.points[7].y() = std::nanf("");
+  EXPECT_EQ(downsample_to_budget(with_nan, 40000).size(), 39999u);  // but finite
   const PointCloud kept = downsample_to_budget(floor, 1000);
   ASSERT_EQ(kept.size(), 1000u);
   ASSERT_EQ(kept.intensity.size(), 1000u);

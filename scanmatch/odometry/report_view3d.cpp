@@ -258,22 +258,25 @@ std::string base64_encode(const std::string& bytes) {
 
 PointCloud downsample_to_budget(const PointCloud& cloud, std::size_t max_points) {
   if (max_points == 0) throw Error("downsample_to_budget: a budget of 0 points");
-  if (cloud.size() <= max_points) return positions_and_intensity(cloud);
+  // The page's 16-bit positions need a finite bounding box.
+  PointCloud finite = positions_and_intensity(cloud);
+  remove_non_finite(finite);
+  if (finite.size() <= max_points) return finite;
   const std::size_t slack = max_points + max_points * 3 / 10;
   // The smallest edge within a factor 1.19 whose voxels fit the slack: doubling from 2 cm until
   // they fit, then halving the last factor of two (in log scale) three times.
   double size = 0.02;
-  if (occupied_voxels(cloud, size) > slack) {
+  if (occupied_voxels(finite, size) > slack) {
     double too_small = size;
     size *= 2;
-    while (occupied_voxels(cloud, size) > slack) too_small = size, size *= 2;
+    while (occupied_voxels(finite, size) > slack) too_small = size, size *= 2;
     for (int step = 0; step < 3; ++step) {
       const double middle = std::sqrt(too_small * size);
-      (occupied_voxels(cloud, middle) > slack ? too_small : size) = middle;
+      (occupied_voxels(finite, middle) > slack ? too_small : size) = middle;
     }
   }
   PointCloud voxels =
-      positions_and_intensity(voxel_downsample(cloud, size, VoxelReduction::kNearestToCentroid));
+      positions_and_intensity(voxel_downsample(finite, size, VoxelReduction::kNearestToCentroid));
   return voxels.size() <= max_points ? voxels : pick_evenly(voxels, max_points);
 }
 

@@ -37,8 +37,8 @@ struct View3DOptions {
 
 /// At most `max_points` of `cloud`, spread evenly over it: a voxel grid at the smallest edge
 /// (from 2 cm, to within a factor 1.19) that leaves at most 1.3 x max_points voxels, then every
-/// n-th of those. Intensities (when present) follow their points. A cloud within the budget is
-/// returned as is.
+/// n-th of those. Intensities (when present) follow their points; non-finite points are dropped.
+/// A cloud within the budget is returned as is otherwise.
 PointCloud downsample_to_budget(const PointCloud& cloud, std::size_t max_points);
 
 /// A map rebuilt from frames: every frame's points placed by its pose (the run's loop-closed
