@@ -52,6 +52,11 @@ void add_report_command(CLI::App& app) {
     options.view3d.frames = o->frames;
     options.view3d.sequence.topic = o->topic;
     options.view3d.sequence.simulator.seed = o->seed;
+    if (!o->frames.empty() && !o->no_3d) {  // a long sequence takes a while to read again
+      std::printf("3D view: rebuilding the map from the frames of %s and the poses of %s\n",
+                  o->frames.c_str(), runs.front().path.c_str());
+      std::fflush(stdout);
+    }
     write_file_atomic(o->out, render_report(runs, gt, options));
     std::printf("report written to %s\n", o->out.c_str());
   });
