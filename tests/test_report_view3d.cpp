@@ -280,7 +280,8 @@ TEST(ReportView3D, PageDrawsMapTrajectoriesAndLoopsInChromium) {
   EXPECT_NE(tip_text.find("health: "), std::string::npos) << tip_text;
   // Every point of the saved map (within the budget), the odometry, the loop-closed poses and
   // the reference (8 poses each), both loop edges.
-  EXPECT_EQ(status["points"].get<std::size_t>(), read_cloud(run + "/map.pcd").size());
+  const PointCloud saved = read_cloud(run + "/map.pcd");
+  EXPECT_EQ(status["points"].get<std::size_t>(), saved.size());
   EXPECT_EQ(status["trajectory_vertices"].get<int>(), 3 * 8);
   EXPECT_EQ(status["loop_edges"].get<int>(), 2);
   // The frames the record flagged are those summary.json counts as not to be trusted or noted.
@@ -305,6 +306,19 @@ TEST(ReportView3D, PageDrawsMapTrajectoriesAndLoopsInChromium) {
   const nlohmann::json rebuilt = page_status(run_chromium(dir, page, "--dump-dom"));
   EXPECT_EQ(rebuilt.value("errors", nlohmann::json::array({"no status"})), nlohmann::json::array());
   EXPECT_EQ(rebuilt["points"].get<int>(), 5000) << rebuilt.dump();
+  EXPECT_EQ(rebuilt["color"], "height");
+
+  // A map with intensities can be coloured by them (these frames have none).
+  PointCloud bright = saved;
+  for (const Point& p : bright.points) bright.intensity.push_back(p.z());
+  write_cloud(run + "/map.pcd", bright);
+  ASSERT_EQ(run_cli("report " + run + " --out " + page).status, 0);
+  const nlohmann::json by_intensity =
+      page_status(run_chromium(dir, page, "--dump-dom", "&color=intensity"));
+  EXPECT_EQ(by_intensity.value("errors", nlohmann::json::array({"no status"})),
+            nlohmann::json::array());
+  EXPECT_EQ(by_intensity["color"], "intensity") << by_intensity.dump();
+  EXPECT_EQ(by_intensity["points"].get<std::size_t>(), bright.size());
 }
 
 TEST(ReportView3D, WithoutThreeJsThePageKeepsItsTwoDimensionalViews) {
