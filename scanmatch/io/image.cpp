@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 
@@ -88,7 +89,86 @@ void write_png_channels(const std::string& path, int width, int height, int chan
   write_file_atomic(path, file);
 }
 
+std::uint32_t read_u32_be(const std::string& bytes, std::size_t at) {
+  return (static_cast<std::uint32_t>(static_cast<std::uint8_t>(bytes[at])) << 24) |
+         (static_cast<std::uint32_t>(static_cast<std::uint8_t>(bytes[at + 1])) << 16) |
+         (static_cast<std::uint32_t>(static_cast<std::uint8_t>(bytes[at + 2])) << 8) |
+         static_cast<std::uint32_t>(static_cast<std::uint8_t>(bytes[at + 3]));
+}
+
+int paeth(int left, int up, int up_left) {
+  const int estimate = left + up - up_left;
+  const int to_left = std::abs(estimate - left), to_up = std::abs(estimate - up),
+            to_up_left = std::abs(estimate - up_left);
+  if (to_left <= to_up && to_left <= to_up_left) return left;
+  return to_up <= to_up_left ? up : up_left;
+}
+
 }  // namespace
+
+Image8 read_png(const std::string& path) {
+  const std::string file = read_file_bytes(path);
+  if (file.size() < 8 || file.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) != 0)
+    fail(path, "not a PNG file (no PNG signature)");
+  Image8 image;
+  std::string compressed;
+  for (std::size_t at = 8; at + 12 <= file.size();) {
+    const std::uint32_t length = read_u32_be(file, at);
+    const std::string type = file.substr(at + 4, 4);
+    if (length > file.size() - at - 12) fail(path, "chunk " + type + " runs past the end");
+    const std::string data = file.substr(at + 8, length);
+    at += 12 + length;
+    if (type == "IHDR") {
+      if (length != 13) fail(path, "IHDR of " + std::to_string(length) + " bytes, not 13");
+      image.width = static_cast<int>(read_u32_be(data, 0));
+      image.height = static_cast<int>(read_u32_be(data, 4));
+      const int depth = data[8], colour = data[9], interlace = data[12];
+      const int channels[] = {1, 0, 3, 0, 2, 0, 4};
+      if (depth != 8 || colour < 0 || colour > 6 || channels[colour] == 0 || interlace != 0)
+        fail(path, "only 8-bit, non-interlaced grey, RGB and alpha PNGs are read (bit depth " +
+                       std::to_string(depth) + ", colour type " + std::to_string(colour) +
+                       ", interlace " + std::to_string(interlace) + ")");
+      image.channels = channels[colour];
+    } else if (type == "IDAT") {
+      compressed += data;
+    } else if (type == "IEND") {
+      break;
+    }
+  }
+  if (image.channels == 0 || image.width <= 0 || image.height <= 0)
+    fail(path, "no IHDR chunk with a positive size");
+  const std::size_t row_bytes = static_cast<std::size_t>(image.width) * image.channels;
+  std::string raw(static_cast<std::size_t>(image.height) * (row_bytes + 1), '\0');
+  uLongf raw_size = static_cast<uLongf>(raw.size());
+  if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &raw_size,
+                 reinterpret_cast<const Bytef*>(compressed.data()),
+                 static_cast<uLong>(compressed.size())) != Z_OK ||
+      raw_size != raw.size())
+    fail(path, "damaged image data (zlib)");
+  // Undo each row's filter against the row above (zero above the first) and the pixel to its left.
+  image.pixels.assign(row_bytes * image.height, 0);
+  const int bpp = image.channels;
+  for (int row = 0; row < image.height; ++row) {
+    const std::uint8_t* in =
+        reinterpret_cast<const std::uint8_t*>(raw.data()) + row * (row_bytes + 1);
+    std::uint8_t* out = image.pixels.data() + row * row_bytes;
+    const std::uint8_t* above = row > 0 ? out - row_bytes : nullptr;
+    const int filter = in[0];
+    if (filter > 4) fail(path, "row " + std::to_string(row) + " has an unknown filter");
+    for (std::size_t k = 0; k < row_bytes; ++k) {
+      const int left = k >= static_cast<std::size_t>(bpp) ? out[k - bpp] : 0;
+      const int up = above ? above[k] : 0;
+      const int up_left = above && k >= static_cast<std::size_t>(bpp) ? above[k - bpp] : 0;
+      const int predictor = filter == 0   ? 0
+                            : filter == 1 ? left
+                            : filter == 2 ? up
+                            : filter == 3 ? (left + up) / 2
+                                          : paeth(left, up, up_left);
+      out[k] = static_cast<std::uint8_t>(in[k + 1] + predictor);
+    }
+  }
+  return image;
+}
 
 void write_pgm(const std::string& path, int width, int height,
                const std::vector<std::uint8_t>& pixels) {

@@ -1,5 +1,6 @@
 #pragma once
-// Writers for 8-bit images: binary PGM (P5) and PNG (grayscale or RGB), encoded here with zlib.
+// Writers for 8-bit images: binary PGM (P5) and PNG (grayscale or RGB), encoded here with zlib;
+// a reader for 8-bit PNG (e.g. a browser's screenshot, which tests inspect).
 // Pixels are row-major with row 0 the top row of the image. Files are written atomically
 // (write_file_atomic), so a reader never sees a half-written image.
 
@@ -23,5 +24,16 @@ void write_png(const std::string& path, int width, int height,
 /// must be 3 * width * height. Throws Error as write_png.
 void write_png_rgb(const std::string& path, int width, int height,
                    const std::vector<std::uint8_t>& rgb);
+
+/// An 8-bit image: `channels` bytes per pixel (1 grey, 2 grey + alpha, 3 RGB, 4 RGBA), row-major
+/// with row 0 the top row.
+struct Image8 {
+  int width = 0, height = 0, channels = 0;
+  std::vector<std::uint8_t> pixels;
+};
+
+/// Reads a non-interlaced 8-bit PNG of colour type 0, 2, 4 or 6 (any of the five row filters).
+/// Throws Error naming the file for anything else or a damaged file.
+Image8 read_png(const std::string& path);
 
 }  // namespace scanmatch

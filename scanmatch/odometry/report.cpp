@@ -11,6 +11,7 @@
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/odometry/health.hpp"
+#include "scanmatch/odometry/report_view3d.hpp"
 
 namespace scanmatch {
 namespace {
@@ -33,22 +34,6 @@ std::map<std::size_t, const FrameStats*> stats_by_frame(const RunFolder& run) {
   std::map<std::size_t, const FrameStats*> out;
   for (const FrameRecord& r : run.timing) out[r.index] = &r.stats;
   return out;
-}
-
-// What the health record says about one frame, in words ("" for a healthy one).
-std::string frame_flags(const FrameStats& f) {
-  std::vector<std::string> flags;
-  if (f.bridged) flags.push_back("bridged");
-  if (f.prior_uncertain) flags.push_back("prior uncertain");
-  if (f.recovered) flags.push_back("recovered by another start");
-  if (health::thin_map(f))
-    flags.push_back(fmt::format("thin map ({:.2f} paired)", f.fine_paired_fraction));
-  if (health::stages_disagree(f))
-    flags.push_back(fmt::format("coarse/fine disagree ({:.2f} m, {:.1f} deg)", f.coarse_fine_m,
-                                f.coarse_fine_deg));
-  std::string text;
-  for (const auto& flag : flags) text += (text.empty() ? "" : ", ") + flag;
-  return text;
 }
 
 // One run's frames: the error of each step against the reference (when there is one) and the
@@ -181,7 +166,7 @@ std::string per_frame_section(const RunFolder& run, const std::optional<Trajecto
         "<th>rotation error (deg)</th><th>health record</th></tr>\n";
     for (std::size_t k = 0; k < shown; ++k) {
       const auto it = stats.find(worst[k].frame);
-      const std::string flags = it == stats.end() ? "-" : frame_flags(*it->second);
+      const std::string flags = it == stats.end() ? "-" : frame_health_flags(*it->second);
       html += fmt::format("<tr><td>{}</td><td>{:.3f}</td><td>{:.2f}</td><td>{}</td></tr>\n",
                           worst[k].frame, worst[k].m, worst[k].deg,
                           flags.empty() ? "healthy" : html_escape(flags));
@@ -192,6 +177,21 @@ std::string per_frame_section(const RunFolder& run, const std::optional<Trajecto
 }
 
 }  // namespace
+
+std::string frame_health_flags(const FrameStats& f) {
+  std::vector<std::string> flags;
+  if (f.bridged) flags.push_back("bridged");
+  if (f.prior_uncertain) flags.push_back("prior uncertain");
+  if (f.recovered) flags.push_back("recovered by another start");
+  if (health::thin_map(f))
+    flags.push_back(fmt::format("thin map ({:.2f} paired)", f.fine_paired_fraction));
+  if (health::stages_disagree(f))
+    flags.push_back(fmt::format("coarse/fine disagree ({:.2f} m, {:.1f} deg)", f.coarse_fine_m,
+                                f.coarse_fine_deg));
+  std::string text;
+  for (const auto& flag : flags) text += (text.empty() ? "" : ", ") + flag;
+  return text;
+}
 
 std::string render_report(const std::vector<RunFolder>& runs,
                           const std::optional<Trajectory>& ground_truth,
@@ -281,6 +281,7 @@ std::string render_report(const std::vector<RunFolder>& runs,
     }
   }
   html += "</table>\n";
+  if (options.view3d.enabled) html += render_view3d(runs, ground_truth, options.view3d);
 
   html += "<h2>Trajectories</h2>\n<div class=\"plots\">\n";
   html += svg_plot(paths, {"Top view", "x (m)", "y (m)", 620, 520, true});
