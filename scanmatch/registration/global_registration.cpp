@@ -1,0 +1,316 @@
+#include "scanmatch/registration/global_registration.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <nanoflann.hpp>
+#include <numeric>
+
+#include "scanmatch/core/alignment.hpp"
+#include "scanmatch/core/error.hpp"
+#include "scanmatch/core/stopwatch.hpp"
+#include "scanmatch/geometry/kdtree.hpp"
+#include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/registration/methods.hpp"
+
+namespace scanmatch {
+namespace {
+
+// Keypoints and their descriptors of one cloud.
+struct Described {
+  PointCloud keypoints;
+  std::vector<FpfhDescriptor> descriptors;
+};
+
+Described describe_cloud(const PointCloud& cloud, const Eigen::Vector3d& viewpoint,
+                         const GlobalRegistrationOptions& options) {
+  const PointCloud down = voxel_downsample(cloud, options.feature_voxel_size);
+  Described out;
+  if (down.size() < 4) return out;
+  const KdTree tree(down.points);
+  FpfhOptions fpfh = options.fpfh;
+  fpfh.viewpoint = viewpoint;
+  fpfh.num_threads = options.num_threads;
+  const std::vector<Eigen::Vector3d> normals =
+      oriented_normals(down, tree, fpfh.normal_neighbours, viewpoint, options.num_threads);
+  // Evenly thinned when there are too many: the cost of matching grows with their product.
+  std::vector<std::size_t> keypoints;
+  const std::size_t n = down.size(),
+                    m = std::min(n, std::max<std::size_t>(options.max_keypoints, 1));
+  for (std::size_t k = 0; k < m; ++k) keypoints.push_back(k * n / m);
+  const std::vector<FpfhDescriptor> descriptors =
+      compute_fpfh(down, tree, normals, keypoints, fpfh);
+  for (std::size_t k = 0; k < keypoints.size(); ++k) {
+    if (descriptors[k].isZero()) continue;  // too few neighbours to describe
+    out.keypoints.points.push_back(down.points[keypoints[k]]);
+    out.descriptors.push_back(descriptors[k]);
+  }
+  return out;
+}
+
+struct DescriptorAdaptor {
+  const std::vector<FpfhDescriptor>& descriptors;
+  std::size_t kdtree_get_point_count() const { return descriptors.size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t dim) const {
+    return descriptors[i][static_cast<int>(dim)];
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using DescriptorTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, DescriptorAdaptor>,
+                                        DescriptorAdaptor, kFpfhBins, std::size_t>;
+
+// For each descriptor of `from`, the index of its nearest descriptor in `to`.
+std::vector<std::size_t> nearest_descriptors(const std::vector<FpfhDescriptor>& from,
+                                             const std::vector<FpfhDescriptor>& to) {
+  const DescriptorAdaptor adaptor{to};
+  DescriptorTree tree(kFpfhBins, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  tree.buildIndex();
+  std::vector<std::size_t> out(from.size());
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    std::size_t index = 0;
+    float distance = 0;
+    nanoflann::KNNResultSet<float, std::size_t> result(1);
+    result.init(&index, &distance);
+    tree.findNeighbors(result, from[i].data(), nanoflann::SearchParams());
+    out[i] = index;
+  }
+  return out;
+}
+
+struct Correspondences {
+  std::vector<Eigen::Vector3d> source, target;
+  std::size_t size() const { return source.size(); }
+};
+
+// Mutual nearest neighbours in descriptor space.
+Correspondences match(const Described& source, const Described& target) {
+  Correspondences out;
+  if (source.descriptors.empty() || target.descriptors.empty()) return out;
+  const auto forward = nearest_descriptors(source.descriptors, target.descriptors);
+  const auto backward = nearest_descriptors(target.descriptors, source.descriptors);
+  for (std::size_t i = 0; i < forward.size(); ++i) {
+    if (backward[forward[i]] != i) continue;
+    out.source.push_back(source.keypoints.points[i].cast<double>());
+    out.target.push_back(target.keypoints.points[forward[i]].cast<double>());
+  }
+  return out;
+}
+
+// The consistency graph as bit rows: i ~ j when the correspondences keep their distance.
+class ConsistencyGraph {
+ public:
+  ConsistencyGraph(const Correspondences& c, double noise_bound)
+      : n_(c.size()), words_((n_ + 63) / 64), bits_(n_ * words_, 0), degree_(n_, 0) {
+    for (std::size_t i = 0; i < n_; ++i)
+      for (std::size_t j = i + 1; j < n_; ++j) {
+        const double ds = (c.source[i] - c.source[j]).norm();
+        const double dt = (c.target[i] - c.target[j]).norm();
+        if (std::abs(ds - dt) > noise_bound) continue;
+        set(i, j);
+        set(j, i);
+        ++degree_[i];
+        ++degree_[j];
+      }
+  }
+  std::size_t size() const { return n_; }
+  std::size_t degree(std::size_t i) const { return degree_[i]; }
+
+  /// A clique containing `seed`, grown by adding the candidates in `order` that stay consistent
+  /// with every member so far.
+  std::vector<std::size_t> grow_clique(std::size_t seed,
+                                       const std::vector<std::size_t>& order) const {
+    std::vector<std::uint64_t> allowed(row(seed), row(seed) + words_);
+    std::vector<std::size_t> clique{seed};
+    for (std::size_t c : order) {
+      if (!((allowed[c / 64] >> (c % 64)) & 1u)) continue;
+      clique.push_back(c);
+      const std::uint64_t* r = row(c);
+      for (std::size_t w = 0; w < words_; ++w) allowed[w] &= r[w];
+    }
+    return clique;
+  }
+
+ private:
+  const std::uint64_t* row(std::size_t i) const { return bits_.data() + i * words_; }
+  void set(std::size_t i, std::size_t j) {
+    bits_[i * words_ + j / 64] |= std::uint64_t{1} << (j % 64);
+  }
+  std::size_t n_, words_;
+  std::vector<std::uint64_t> bits_;
+  std::vector<std::size_t> degree_;
+};
+
+struct Hypothesis {
+  Pose transform = Pose::Identity();
+  std::size_t clique = 0, inliers = 0;
+};
+
+Pose fit(const Correspondences& c, const std::vector<std::size_t>& members) {
+  std::vector<Eigen::Vector3d> from, to;
+  for (std::size_t i : members) {
+    from.push_back(c.source[i]);
+    to.push_back(c.target[i]);
+  }
+  return umeyama_alignment(from, to, false).transform;
+}
+
+std::vector<std::size_t> explained(const Correspondences& c, const Pose& T, double bound) {
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if ((T * c.source[i] - c.target[i]).norm() <= bound) out.push_back(i);
+  return out;
+}
+
+// The clique's motion, re-fitted twice on every correspondence it explains.
+Hypothesis hypothesis_of(const Correspondences& c, const std::vector<std::size_t>& clique,
+                         double bound) {
+  Hypothesis h;
+  h.clique = clique.size();
+  h.transform = fit(c, clique);
+  std::vector<std::size_t> members = explained(c, h.transform, bound);
+  for (int round = 0; round < 2 && members.size() >= 3; ++round) {
+    h.transform = fit(c, members);
+    members = explained(c, h.transform, bound);
+  }
+  h.inliers = members.size();
+  return h;
+}
+
+bool same_motion(const Pose& a, const Pose& b, const GlobalRegistrationOptions& o) {
+  const Pose d = a.inverse() * b;
+  return d.translation().norm() <= o.distinct_translation &&
+         rotation_angle(d) <= o.distinct_rotation;
+}
+
+void check_options(const GlobalRegistrationOptions& o) {
+  const auto bad = [](const std::string& what) { fail("global registration", what); };
+  if (!(o.feature_voxel_size > 0.0)) bad("the feature voxel size must be positive");
+  if (!(o.fpfh.radius > 0.0)) bad("the FPFH radius must be positive");
+  if (o.fpfh.normal_neighbours < 3) bad("normals need at least 3 neighbours");
+  if (!(o.noise_bound > 0.0)) bad("the noise bound must be positive");
+  if (o.min_inliers < 3) bad("at least 3 inliers are needed for a rigid motion");
+  if (!(o.refine_voxel_size >= 0.0)) bad("the refinement voxel size must not be negative");
+}
+
+}  // namespace
+
+RegistrationOptions global_refinement_defaults() {
+  RegistrationOptions o;
+  o.method = "vgicp";
+  o.solver.max_iterations = 60;
+  return o;
+}
+
+std::string GlobalRegistrationResult::summary() const {
+  return fmt::format(
+      "{} inliers of {} correspondences ({:.1f} %; clique {}; keypoints {} / {}), second motion {} "
+      "(ambiguity {:.2f}), overlap {:.1f} %, fitness {:.4g} m^2",
+      inliers, correspondences, 100.0 * inlier_ratio, clique_size, source_keypoints,
+      target_keypoints, second_inliers, ambiguity, 100.0 * overlap, fitness);
+}
+
+GlobalRegistrationResult register_global(const PointCloud& source, const PointCloud& target,
+                                         const GlobalRegistrationOptions& options) {
+  if (source.empty()) fail("global registration", "the source cloud is empty");
+  if (target.empty()) fail("global registration", "the target cloud is empty");
+  check_options(options);
+  GlobalRegistrationResult r;
+  const auto give_up = [&r](const std::string& why) {
+    r.success = false;
+    r.failure = why;
+    return r;
+  };
+
+  const Stopwatch feature_time;
+  const Described s = describe_cloud(source, options.source_viewpoint, options);
+  const Described t = describe_cloud(target, options.target_viewpoint, options);
+  r.feature_ms = feature_time.ms();
+  r.source_keypoints = s.keypoints.size();
+  r.target_keypoints = t.keypoints.size();
+
+  const Stopwatch matching_time;
+  const Correspondences c = match(s, t);
+  r.correspondences = c.size();
+  if (c.size() < options.min_inliers)
+    return give_up(
+        fmt::format("too few feature matches ({} mutual, {} needed): too little "
+                    "structure at {} m voxels",
+                    c.size(), options.min_inliers, options.feature_voxel_size));
+
+  const ConsistencyGraph graph(c, options.noise_bound);
+  std::vector<std::size_t> order(c.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&graph](std::size_t a, std::size_t b) {
+    return graph.degree(a) > graph.degree(b);
+  });
+  std::vector<Hypothesis> hypotheses;
+  const std::size_t seeds = std::min(order.size(), std::max<std::size_t>(options.clique_seeds, 1));
+  for (std::size_t k = 0; k < seeds; ++k) {
+    if (graph.degree(order[k]) < 2) break;
+    const std::vector<std::size_t> clique = graph.grow_clique(order[k], order);
+    if (clique.size() < 3) continue;
+    r.clique_size = std::max(r.clique_size, clique.size());
+    hypotheses.push_back(hypothesis_of(c, clique, options.noise_bound));
+  }
+  r.matching_ms = matching_time.ms();
+  if (hypotheses.empty())
+    return give_up(
+        fmt::format("no three of the {} feature matches agree on a rigid motion", c.size()));
+  const auto best = std::max_element(
+      hypotheses.begin(), hypotheses.end(),
+      [](const Hypothesis& a, const Hypothesis& b) { return a.inliers < b.inliers; });
+  for (const Hypothesis& h : hypotheses)
+    if (!same_motion(h.transform, best->transform, options))
+      r.second_inliers = std::max(r.second_inliers, h.inliers);
+  r.inliers = best->inliers;
+  r.inlier_ratio = static_cast<double>(r.inliers) / static_cast<double>(c.size());
+  r.ambiguity = static_cast<double>(r.second_inliers) / static_cast<double>(r.inliers);
+  r.coarse_transform = best->transform;
+  r.transform = best->transform;
+  if (r.inliers < options.min_inliers)
+    return give_up(
+        fmt::format("weak evidence: the best motion explains {} of {} feature matches "
+                    "({} needed)",
+                    r.inliers, c.size(), options.min_inliers));
+  if (r.ambiguity > options.max_ambiguity)
+    return give_up(
+        fmt::format("ambiguous: a different motion explains {} matches against the "
+                    "best's {} (ratio {:.2f} > {:.2f})",
+                    r.second_inliers, r.inliers, r.ambiguity, options.max_ambiguity));
+
+  const Stopwatch refine_time;
+  const PointCloud fine_source = options.refine_voxel_size > 0.0
+                                     ? voxel_downsample(source, options.refine_voxel_size)
+                                     : source;
+  const PointCloud fine_target = options.refine_voxel_size > 0.0
+                                     ? voxel_downsample(target, options.refine_voxel_size)
+                                     : target;
+  if (options.refine) {
+    try {
+      r.refinement = register_clouds(fine_source, fine_target, options.refinement, r.transform);
+      r.transform = r.refinement.transform;
+    } catch (const Error& e) {
+      return give_up(std::string("the refinement failed: ") + e.what());
+    }
+  }
+  std::size_t matched = 0;
+  r.fitness =
+      fitness_score(fine_source, fine_target, r.transform, options.feature_voxel_size, &matched);
+  r.overlap = static_cast<double>(matched) / static_cast<double>(fine_source.size());
+  r.refine_ms = refine_time.ms();
+  if (r.overlap < options.min_overlap)
+    return give_up(
+        fmt::format("the clouds hardly overlap under the result ({:.1f} % of source "
+                    "points within {} m of the target, {:.1f} % needed)",
+                    100.0 * r.overlap, options.feature_voxel_size, 100.0 * options.min_overlap));
+  r.success = true;
+  return r;
+}
+
+}  // namespace scanmatch
