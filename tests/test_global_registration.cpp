@@ -212,6 +212,29 @@ TEST(GlobalRegistration, FailsAndSaysSoOnAPlaneOrOnNoise) {
   EXPECT_THROW(register_global(scan, scan, bad), Error);
 }
 
+// The target holds the same place twice (two copies 300 m apart, each with its own 2 cm noise, and
+// the target's viewpoint, the origin, halfway between them): two motions fit equally well, so
+// the answer must be "ambiguous", not one of them.
+TEST(GlobalRegistration, RefusesWhenTwoPlacesFitEqually) {
+  sim::SimOptions so;
+  so.preset = "campus-os1";
+  so.frames = 46;
+  so.motion_distortion = false;
+  const sim::Simulator s(so);
+  const PointCloud source = s.frame(45), place = s.frame(40);
+  PointCloud target;
+  std::mt19937 rng(5);
+  std::normal_distribution<float> jitter(0.0f, 0.02f);
+  for (const float shift : {-150.0f, 150.0f})
+    for (const Point& p : place.points)
+      target.points.push_back(p + Point(shift + jitter(rng), jitter(rng), jitter(rng)));
+  const GlobalRegistrationResult r = register_global(source, target);
+  std::cout << r.failure << "; " << r.summary() << "\n";
+  EXPECT_FALSE(r.success) << r.summary();
+  EXPECT_GT(r.ambiguity, GlobalRegistrationOptions{}.max_ambiguity) << r.summary();
+  EXPECT_NE(r.failure.find("ambiguous"), std::string::npos) << r.failure;
+}
+
 TEST(Cli, RegisterGlobalPrintsEvidenceAndFailsClearly) {
   scanmatch::testing::TempDir dir;
   sim::SimOptions so;

@@ -249,30 +249,55 @@ GlobalRegistrationResult register_global(const PointCloud& source, const PointCl
   std::stable_sort(order.begin(), order.end(), [&graph](std::size_t a, std::size_t b) {
     return graph.degree(a) > graph.degree(b);
   });
-  std::vector<Hypothesis> hypotheses;
-  const std::size_t seeds = std::min(order.size(), std::max<std::size_t>(options.clique_seeds, 1));
-  for (std::size_t k = 0; k < seeds; ++k) {
-    if (graph.degree(order[k]) < 2) break;
-    const std::vector<std::size_t> clique = graph.grow_clique(order[k], order);
-    if (clique.size() < 3) continue;
-    r.clique_size = std::max(r.clique_size, clique.size());
-    hypotheses.push_back(hypothesis_of(c, clique, options.noise_bound));
-  }
+  // Cliques grown from the best-connected correspondences in `candidates` (degree order).
+  const auto hypotheses_from = [&](const std::vector<std::size_t>& candidates) {
+    std::vector<Hypothesis> out;
+    const std::size_t seeds =
+        std::min(candidates.size(), std::max<std::size_t>(options.clique_seeds, 1));
+    for (std::size_t k = 0; k < seeds; ++k) {
+      if (graph.degree(candidates[k]) < 2) break;
+      const std::vector<std::size_t> clique = graph.grow_clique(candidates[k], candidates);
+      if (clique.size() < 3) continue;
+      r.clique_size = std::max(r.clique_size, clique.size());
+      out.push_back(hypothesis_of(c, clique, options.noise_bound));
+    }
+    return out;
+  };
+  const auto most_inliers = [](const std::vector<Hypothesis>& hs) {
+    return std::max_element(hs.begin(), hs.end(), [](const Hypothesis& a, const Hypothesis& b) {
+      return a.inliers < b.inliers;
+    });
+  };
+  std::vector<Hypothesis> hypotheses = hypotheses_from(order);
   r.matching_ms = matching_time.ms();
   if (hypotheses.empty())
     return give_up(
         fmt::format("no three of the {} feature matches agree on a rigid motion", c.size()));
-  const auto best = std::max_element(
-      hypotheses.begin(), hypotheses.end(),
-      [](const Hypothesis& a, const Hypothesis& b) { return a.inliers < b.inliers; });
-  for (const Hypothesis& h : hypotheses)
-    if (!same_motion(h.transform, best->transform, options))
-      r.second_inliers = std::max(r.second_inliers, h.inliers);
-  r.inliers = best->inliers;
+  const Hypothesis best = *most_inliers(hypotheses);
+  // The runner-up: the best different motion, also among the matches the best leaves
+  // unexplained (a second copy of a place may have no seed among the best-connected ones).
+  std::vector<char> explained_by_best(c.size(), 0);
+  for (std::size_t i : explained(c, best.transform, options.noise_bound)) explained_by_best[i] = 1;
+  std::vector<std::size_t> rest;
+  for (std::size_t i : order)
+    if (!explained_by_best[i]) rest.push_back(i);
+  const std::vector<Hypothesis> others = hypotheses_from(rest);
+  hypotheses.insert(hypotheses.end(), others.begin(), others.end());
+  // Counted on the matches the best leaves unexplained: a variant of the best motion (a few
+  // degrees off about the inliers' centre) shares most of its matches and is no rival.
+  for (const Hypothesis& h : hypotheses) {
+    if (same_motion(h.transform, best.transform, options)) continue;
+    std::size_t own = 0;
+    for (std::size_t i : explained(c, h.transform, options.noise_bound))
+      own += !explained_by_best[i];
+    r.second_inliers = std::max(r.second_inliers, own);
+  }
+  r.matching_ms = matching_time.ms();
+  r.inliers = best.inliers;
   r.inlier_ratio = static_cast<double>(r.inliers) / static_cast<double>(c.size());
   r.ambiguity = static_cast<double>(r.second_inliers) / static_cast<double>(r.inliers);
-  r.coarse_transform = best->transform;
-  r.transform = best->transform;
+  r.coarse_transform = best.transform;
+  r.transform = best.transform;
   if (r.inliers < options.min_inliers)
     return give_up(
         fmt::format("weak evidence: the best motion explains {} of {} feature matches "

@@ -9,8 +9,9 @@
 // `noise_bound`, a rigid motion's correct matches are pairwise consistent, so they form a large
 // clique of the consistency graph. Cliques are grown greedily from many seeds; each gives a
 // closed-form (Umeyama) hypothesis, re-fitted on every correspondence it explains. The best
-// hypothesis must explain `min_inliers` correspondences and clearly more than the best hypothesis
-// that is a different motion (ambiguity = second / best); it is then refined by a local method
+// hypothesis must explain `min_inliers` correspondences and clearly more than any different
+// motion explains among the rest (ambiguity = second / best; the search for that rival is re-run
+// on the correspondences the best leaves unexplained); it is then refined by a local method
 // (registration/methods.hpp) and the refined overlap checked.
 //
 // Use from a pipeline: `register_global(source, target, options)`; when `result.success`, use
@@ -41,7 +42,7 @@ struct GlobalRegistrationOptions {
   double noise_bound = 0.4;        ///< m, largest distance error of a correct correspondence
   std::size_t clique_seeds = 300;  ///< correspondences (highest consistency degree) grown from
   std::size_t min_inliers = 12;    ///< correspondences the best hypothesis must explain
-  double max_ambiguity = 0.7;  ///< fail when a different motion explains this share of the best's
+  double max_ambiguity = 0.5;  ///< fail when a different motion explains this share of the best's
   double distinct_translation = 2.0;  ///< m, hypotheses further apart are different motions
   double distinct_rotation = 10.0 * M_PI / 180;  ///< rad, likewise
   bool refine = true;                            ///< refine the global result with `refinement`
@@ -61,7 +62,8 @@ struct GlobalRegistrationResult {
   std::size_t clique_size = 0;      ///< largest consistent set found
   std::size_t inliers = 0;          ///< correspondences the best hypothesis explains
   double inlier_ratio = 0.0;        ///< inliers / correspondences
-  std::size_t second_inliers = 0;   ///< the same for the best different motion
+  std::size_t second_inliers = 0;   ///< matches the best different motion explains and the
+                                    ///< best does not
   double ambiguity = 0.0;           ///< second_inliers / inliers
   double overlap = 0.0;  ///< share of (refine-voxel) source points within feature_voxel_size of
                          ///< a target point under the final transform
