@@ -114,25 +114,33 @@ std::vector<FpfhDescriptor> compute_fpfh(const PointCloud& cloud, const KdTree& 
                                std::to_string(cloud.size()) + " points)");
   if (!(options.radius > 0.0)) fail("compute_fpfh", "the radius must be positive");
 
-  // SPFH of every point that is a keypoint or a keypoint's neighbour.
-  std::vector<std::vector<Neighbour>> keypoint_neighbours(keypoints.size());
+  // SPFH of every point that is a keypoint or a keypoint's neighbour; each neighbourhood is
+  // searched once (a keypoint's serves both its SPFH and its FPFH).
+  std::vector<std::vector<Neighbour>> neighbours(cloud.size());
+  std::vector<char> searched(cloud.size(), 0);
   for_each_index(keypoints.size(), options.num_threads, [&](std::size_t k) {
-    keypoint_neighbours[k] = neighbours_within(cloud, tree, keypoints[k], options);
+    neighbours[keypoints[k]] = neighbours_within(cloud, tree, keypoints[k], options);
   });
+  for (std::size_t k : keypoints) searched[k] = 1;
   std::vector<char> needed(cloud.size(), 0);
-  for (std::size_t k = 0; k < keypoints.size(); ++k) {
-    needed[keypoints[k]] = 1;
-    for (const Neighbour& nb : keypoint_neighbours[k]) needed[nb.index] = 1;
+  for (std::size_t k : keypoints) {
+    needed[k] = 1;
+    for (const Neighbour& nb : neighbours[k]) needed[nb.index] = 1;
   }
-  std::vector<std::size_t> needed_points;
-  for (std::size_t i = 0; i < cloud.size(); ++i)
+  std::vector<std::size_t> needed_points, unsearched;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (needed[i]) needed_points.push_back(i);
+    if (needed[i] && !searched[i]) unsearched.push_back(i);
+  }
+  for_each_index(unsearched.size(), options.num_threads, [&](std::size_t j) {
+    neighbours[unsearched[j]] = neighbours_within(cloud, tree, unsearched[j], options);
+  });
   std::vector<FpfhDescriptor> spfh(cloud.size(), FpfhDescriptor::Zero());
   for_each_index(needed_points.size(), options.num_threads, [&](std::size_t j) {
     const std::size_t i = needed_points[j];
     const Eigen::Vector3d p = cloud.points[i].cast<double>();
     FpfhDescriptor h = FpfhDescriptor::Zero();
-    for (const Neighbour& nb : neighbours_within(cloud, tree, i, options)) {
+    for (const Neighbour& nb : neighbours[i]) {
       Eigen::Vector3d a;
       if (!fpfh_pair_angles(p, normals[i], cloud.points[nb.index].cast<double>(), normals[nb.index],
                             a))
@@ -147,7 +155,7 @@ std::vector<FpfhDescriptor> compute_fpfh(const PointCloud& cloud, const KdTree& 
 
   std::vector<FpfhDescriptor> out(keypoints.size(), FpfhDescriptor::Zero());
   for_each_index(keypoints.size(), options.num_threads, [&](std::size_t k) {
-    const auto& nbs = keypoint_neighbours[k];
+    const auto& nbs = neighbours[keypoints[k]];
     if (nbs.size() < 3) return;
     FpfhDescriptor neighbours = FpfhDescriptor::Zero();
     for (const Neighbour& nb : nbs) neighbours += spfh[nb.index] / nb.distance;

@@ -3,9 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <bit>
 #include <cstdint>
-#include <nanoflann.hpp>
+#include <limits>
 #include <numeric>
 
 #include "scanmatch/core/alignment.hpp"
@@ -50,37 +49,40 @@ Described describe_cloud(const PointCloud& cloud, const Eigen::Vector3d& viewpoi
   return out;
 }
 
-struct DescriptorAdaptor {
-  const std::vector<FpfhDescriptor>& descriptors;
-  std::size_t kdtree_get_point_count() const { return descriptors.size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t dim) const {
-    return descriptors[i][static_cast<int>(dim)];
+// For each descriptor of `a` the index of its nearest in `b`, and for each of `b` its nearest in
+// `a`: exhaustive, the squared distances |x|^2 + |y|^2 - 2 x.y from one matrix product per block
+// of `a` (in 33 dimensions a k-d tree visits most leaves anyway and was 2x slower).
+void nearest_both_ways(const std::vector<FpfhDescriptor>& a, const std::vector<FpfhDescriptor>& b,
+                       std::vector<std::size_t>& a_to_b, std::vector<std::size_t>& b_to_a) {
+  const auto n = static_cast<Eigen::Index>(a.size()), m = static_cast<Eigen::Index>(b.size());
+  Eigen::MatrixXf A(kFpfhBins, n), B(kFpfhBins, m);
+  for (Eigen::Index i = 0; i < n; ++i) A.col(i) = a[static_cast<std::size_t>(i)];
+  for (Eigen::Index j = 0; j < m; ++j) B.col(j) = b[static_cast<std::size_t>(j)];
+  const Eigen::VectorXf a2 = A.colwise().squaredNorm().transpose();
+  const Eigen::VectorXf b2 = B.colwise().squaredNorm().transpose();
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  std::vector<float> best_a(a.size(), kInfinity), best_b(b.size(), kInfinity);
+  a_to_b.assign(a.size(), 0);
+  b_to_a.assign(b.size(), 0);
+  constexpr Eigen::Index kBlock = 256;
+  Eigen::MatrixXf D;
+  for (Eigen::Index first = 0; first < n; first += kBlock) {
+    const Eigen::Index rows = std::min(kBlock, n - first);
+    D.noalias() = A.middleCols(first, rows).transpose() * B;
+    for (Eigen::Index j = 0; j < m; ++j)
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        const auto i = static_cast<std::size_t>(first + r), jj = static_cast<std::size_t>(j);
+        const float d = a2[first + r] + b2[j] - 2.0f * D(r, j);
+        if (d < best_a[i]) {
+          best_a[i] = d;
+          a_to_b[i] = jj;
+        }
+        if (d < best_b[jj]) {
+          best_b[jj] = d;
+          b_to_a[jj] = i;
+        }
+      }
   }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-using DescriptorTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, DescriptorAdaptor>,
-                                        DescriptorAdaptor, kFpfhBins, std::size_t>;
-
-// For each descriptor of `from`, the index of its nearest descriptor in `to`.
-std::vector<std::size_t> nearest_descriptors(const std::vector<FpfhDescriptor>& from,
-                                             const std::vector<FpfhDescriptor>& to) {
-  const DescriptorAdaptor adaptor{to};
-  DescriptorTree tree(kFpfhBins, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
-  tree.buildIndex();
-  std::vector<std::size_t> out(from.size());
-  for (std::size_t i = 0; i < from.size(); ++i) {
-    std::size_t index = 0;
-    float distance = 0;
-    nanoflann::KNNResultSet<float, std::size_t> result(1);
-    result.init(&index, &distance);
-    tree.findNeighbors(result, from[i].data(), nanoflann::SearchParams());
-    out[i] = index;
-  }
-  return out;
 }
 
 struct Correspondences {
@@ -92,8 +94,8 @@ struct Correspondences {
 Correspondences match(const Described& source, const Described& target) {
   Correspondences out;
   if (source.descriptors.empty() || target.descriptors.empty()) return out;
-  const auto forward = nearest_descriptors(source.descriptors, target.descriptors);
-  const auto backward = nearest_descriptors(target.descriptors, source.descriptors);
+  std::vector<std::size_t> forward, backward;
+  nearest_both_ways(source.descriptors, target.descriptors, forward, backward);
   for (std::size_t i = 0; i < forward.size(); ++i) {
     if (backward[forward[i]] != i) continue;
     out.source.push_back(source.keypoints.points[i].cast<double>());
