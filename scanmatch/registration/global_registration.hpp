@@ -36,20 +36,21 @@ RegistrationOptions global_refinement_defaults();
 struct GlobalRegistrationOptions {
   double feature_voxel_size = 0.5;   ///< m, voxel grid of the keypoints and their neighbourhoods
   std::size_t max_keypoints = 4000;  ///< per cloud; more downsampled points are thinned evenly
-  FpfhOptions fpfh;                  ///< radius 2.5 m = 5 voxels; viewpoints: the clouds' origins
+  FpfhOptions fpfh;  ///< radius 2.5 m = 5 voxels (its viewpoint is replaced by the two below)
   Eigen::Vector3d source_viewpoint = Eigen::Vector3d::Zero();  ///< sensor position, source frame
   Eigen::Vector3d target_viewpoint = Eigen::Vector3d::Zero();  ///< sensor position, target frame
   double noise_bound = 0.4;        ///< m, largest distance error of a correct correspondence
   std::size_t clique_seeds = 300;  ///< correspondences (highest consistency degree) grown from
   std::size_t min_inliers = 12;    ///< correspondences the best hypothesis must explain
-  double max_ambiguity = 0.5;  ///< fail when a different motion explains this share of the best's
+  double max_ambiguity = 0.5;  ///< fail when a different motion explains more than this share of
+                               ///< the best's count among the matches the best leaves unexplained
   double distinct_translation = 2.0;  ///< m, hypotheses further apart are different motions
   double distinct_rotation = 10.0 * M_PI / 180;  ///< rad, likewise
   bool refine = true;                            ///< refine the global result with `refinement`
   double refine_voxel_size = 0.25;  ///< m, voxel grid of both clouds for the refinement (0: none)
   RegistrationOptions refinement = global_refinement_defaults();
   double min_overlap = 0.3;  ///< fail below this share of refined source points near the target
-  int num_threads = 1;
+  int num_threads = 1;       ///< TBB threads for normals and descriptors
 };
 
 struct GlobalRegistrationResult {
