@@ -1,4 +1,5 @@
-// `scanmatch register SOURCE TARGET --method NAME`: the transform that maps SOURCE into TARGET.
+// `scanmatch register SOURCE TARGET --method NAME`: the transform that maps SOURCE into TARGET;
+// with --global, found with no initial guess (registration/global_registration.hpp).
 
 #include <fmt/format.h>
 
@@ -12,6 +13,7 @@
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
+#include "scanmatch/registration/global_registration.hpp"
 #include "scanmatch/registration/methods.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
@@ -25,7 +27,72 @@ struct RegisterCommand {
   bool json = false;
   PairRegistrationOptions pair;
   const CLI::Option *method = nullptr, *max_distance = nullptr;  ///< given: they apply to --2d
+  bool global = false;
+  GlobalRegistrationOptions global_options;
+  const CLI::Option *voxel = nullptr, *max_iterations = nullptr;  ///< given: they apply to --global
 };
+
+std::vector<std::vector<double>> matrix_rows(const Pose& T) {
+  const Eigen::Matrix4d M = to_matrix(T);
+  std::vector<std::vector<double>> rows(4, std::vector<double>(4));
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) rows[i][j] = M(i, j);
+  return rows;
+}
+
+// --global: no initial guess; the global stage's evidence, and a non-zero exit when it cannot.
+void run_global(RegisterCommand& c, const PointCloud& source, const PointCloud& target) {
+  GlobalRegistrationOptions o = c.global_options;
+  // The refinement: --method and the registration flags when given, else the global defaults.
+  const RegistrationOptions defaults = o.refinement;
+  o.refinement = c.pair.registration;
+  if (c.method->count() == 0) o.refinement.method = defaults.method;
+  if (c.max_iterations->count() == 0)
+    o.refinement.solver.max_iterations = defaults.solver.max_iterations;
+  if (c.voxel->count() > 0) o.refine_voxel_size = c.pair.voxel_size;
+  o.num_threads = c.pair.registration.solver.num_threads;
+  const auto start = std::chrono::steady_clock::now();
+  const GlobalRegistrationResult r = register_global(source, target, o);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (c.json) {
+    nlohmann::ordered_json j;
+    j["success"] = r.success;
+    if (!r.success) j["failure"] = r.failure;
+    j["transform"] = matrix_rows(r.transform);
+    j["coarse_transform"] = matrix_rows(r.coarse_transform);
+    j["refinement_method"] = o.refine ? o.refinement.method : "none";
+    j["source_keypoints"] = r.source_keypoints;
+    j["target_keypoints"] = r.target_keypoints;
+    j["correspondences"] = r.correspondences;
+    j["clique_size"] = r.clique_size;
+    j["inliers"] = r.inliers;
+    j["inlier_ratio"] = r.inlier_ratio;
+    j["second_inliers"] = r.second_inliers;
+    j["ambiguity"] = r.ambiguity;
+    j["overlap"] = r.overlap;
+    j["fitness"] = r.fitness;
+    j["iterations"] = r.refinement.iterations;
+    j["feature_ms"] = r.feature_ms;
+    j["matching_ms"] = r.matching_ms;
+    j["refine_ms"] = r.refine_ms;
+    j["time_ms"] = ms;
+    fmt::print("{}\n", j.dump(2));
+  } else if (r.success) {
+    const Eigen::Matrix4d M = to_matrix(r.transform);
+    for (int i = 0; i < 4; ++i)
+      fmt::print("{:12.8f} {:12.8f} {:12.8f} {:12.8f}\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
+    fmt::print("global: {}\n", r.summary());
+    fmt::print(
+        "refined by {} ({} iterations); features {:.0f} ms, matching {:.0f} ms, refinement "
+        "{:.0f} ms, {:.0f} ms in all\n",
+        o.refine ? o.refinement.method : "nothing", r.refinement.iterations, r.feature_ms,
+        r.matching_ms, r.refine_ms, ms);
+  }
+  if (!r.success)
+    throw Error("cannot register " + c.source + " onto " + c.target + " globally: " + r.failure +
+                " (evidence: " + r.summary() + ")");
+}
 
 // "16 numbers" (row-major 4x4) or "x,y,z,roll,pitch,yaw" (metres and degrees).
 Pose parse_initial_guess(const std::string& text) {
@@ -116,10 +183,12 @@ void run(RegisterCommand& c) {
     check_registration_2d_method(c.planar_options.method);
     return run_2d(c);
   }
+  if (c.global && !c.init.empty()) throw Error("--global takes no initial guess: leave out --init");
   const Pose initial = c.init.empty() ? Pose::Identity() : parse_initial_guess(c.init);
   PointCloud source = read_cloud(c.source), target = read_cloud(c.target);
   if (source.empty()) throw Error(c.source + ": the cloud is empty");
   if (target.empty()) throw Error(c.target + ": the cloud is empty");
+  if (c.global) return run_global(c, source, target);
   if (c.pair.voxel_size > 0.0) {
     source = voxel_downsample(source, c.pair.voxel_size);
     target = voxel_downsample(target, c.pair.voxel_size);
@@ -179,6 +248,25 @@ void add_register_command(CLI::App& app) {
       ->capture_default_str();
   add_config_options(cmd, c->pair);
   c->max_distance = cmd->get_option("--max-distance");
+  c->voxel = cmd->get_option("--voxel");
+  c->max_iterations = cmd->get_option("--max-iterations");
+  cmd->add_flag("--global", c->global,
+                "No initial guess: FPFH features, a maximum consistent set of matches, then "
+                "--method (default vgicp) from there; exits non-zero when the evidence is weak");
+  auto& g = c->global_options;
+  cmd->add_option("--feature-voxel", g.feature_voxel_size, "--global: keypoint voxel size, m")
+      ->capture_default_str();
+  cmd->add_option("--feature-radius", g.fpfh.radius, "--global: FPFH neighbourhood radius, m")
+      ->capture_default_str();
+  cmd->add_option("--noise-bound", g.noise_bound,
+                  "--global: largest distance error of a correct feature match, m")
+      ->capture_default_str();
+  cmd->add_option("--min-inliers", g.min_inliers,
+                  "--global: feature matches the best motion must explain")
+      ->capture_default_str();
+  cmd->add_option("--max-ambiguity", g.max_ambiguity,
+                  "--global: fail when another motion explains this share of the best's matches")
+      ->capture_default_str();
   cmd->add_flag("--json", c->json, "Print JSON");
   cmd->add_flag("--2d", c->planar,
                 "2D laser scans: SOURCE and TARGET are CARMEN logs, LOG or LOG:INDEX; methods " +
