@@ -7,6 +7,20 @@
 #include "scanmatch/core/stopwatch.hpp"
 
 namespace scanmatch {
+namespace {
+
+/// Frames follow one another (the world anchor may be extrapolated across them) when the time
+/// step is within this many of frame 0's sweeps.
+constexpr double kContiguousSweeps = 1.5;
+
+/// Under constant acceleration, the motion per frame over frame 0's first half (its value at the
+/// first quarter), from the first two mid-to-mid motions v1 and v2 (the rates at frames 1 and 2's
+/// starts): v1 - 0.75 (v2 - v1).
+Vector6d first_half_rate(const Vector6d& v1, const Vector6d& v2) {
+  return 1.75 * v1 - 0.75 * v2;
+}
+
+}  // namespace
 
 OdometryPipeline::OdometryPipeline(const OdometryConfig& config, bool keep_attributes,
                                    bool map_points, bool deskews_again)
@@ -80,15 +94,14 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
     reported = pose_ * se3_exp(-0.5 * se3_log(velocity));
     // The world is frame 0's start pose: half of frame 0's motion before its mid-frame pose (the
     // internal origin). Frame 1 takes the first measured motion (mid-frame 0 to 1) for it; frame 2
-    // extrapolates the rate back to frame 0's first half (constant acceleration: 1.75 v1 -
-    // 0.75 v2; a hand-held turn slows from 25 to 16.5 deg per frame), and the runner reports
-    // frame 1 again under that (settled_pose). The extrapolation doubles the registrations' noise,
-    // so only where it can pay: where frames follow one another (a step within 1.5 sweeps: across
-    // keyframes 0.5 s apart a car speeding up is no constant acceleration, campus-os1 every 5th
-    // frame 0.29 -> 1.85 %), for a registration trusted to deskew again (gicp 0.255 -> 0.290 %),
-    // and where the motion changed by more than the dead band. Only the parts of the motion above
-    // anchor_min_* anchor the world at all (a still start's noise or a robot's jitter would turn
-    // every later pose).
+    // extrapolates the rate back to frame 0's first half (first_half_rate; a hand-held turn slows
+    // from 25 to 16.5 deg per frame), and the runner reports frame 1 again under that
+    // (settled_pose). The extrapolation doubles the registrations' noise, so only where it can
+    // pay: where frames follow one another (kContiguousSweeps: across keyframes 0.5 s apart a car
+    // speeding up is no constant acceleration, campus-os1 every 5th frame 0.29 -> 1.85 %), for a
+    // registration trusted to deskew again (gicp 0.255 -> 0.290 %), and where the motion changed
+    // by more than the dead band. Only the parts of the motion above anchor_min_* anchor the world
+    // at all (a still start's noise or a robot's jitter would turn every later pose).
     if (frames_ == 1) {
       first_velocity_ = se3_log(velocity);
       anchor_rotation_ = first_velocity_.head<3>().norm() >= config_.anchor_min_rotation;
@@ -96,10 +109,10 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
       world_from_internal_ = se3_exp(0.5 * anchored_part(first_velocity_));
     }
     if (frames_ == 2 && deskews_again_ && !stats_.bridged &&
-        motion_.frame_period() <= 1.5 * first_sweep_ &&
+        motion_.frame_period() <= kContiguousSweeps * first_sweep_ &&
         motion_.moving(se3_exp(first_velocity_).inverse() * velocity))
       world_from_internal_ =
-          se3_exp(0.5 * anchored_part(1.75 * first_velocity_ - 0.75 * se3_log(velocity)));
+          se3_exp(0.5 * anchored_part(first_half_rate(first_velocity_, se3_log(velocity))));
   }
   if (frames_ < kWorldSettlesAfter) early_starts_[frames_] = reported;
   reported = world_from_internal_ * reported;
