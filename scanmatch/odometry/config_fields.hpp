@@ -143,6 +143,14 @@ void describe(OdometryConfig& c, Visitor& v) {
     "deskew again by the registered motion where it misses the prior by this, m per frame");
   v("redeskew_rotation", c.redeskew_rotation, nullptr,
     "likewise for rotation, rad per frame (both 0: never)");
+  v("spin_times", c.spin_times, "--spin-times",
+    "Frames without point times (a spinning LiDAR's raw sweeps, e.g. KITTI raw .bin): derive each "
+    "point's time from its azimuth, so they are deskewed");
+  v("spin_period", c.spin_period, nullptr, "spin_times: s per turn of the sensor");
+  v("spin_start_azimuth", c.spin_start_azimuth, nullptr,
+    "spin_times: azimuth where each sweep starts, rad (atan2(y, x); 0: along +x)");
+  v("spin_clockwise", c.spin_clockwise, nullptr,
+    "spin_times: the sensor turns clockwise seen from above (azimuth decreasing with time)");
   v("anchor_min_translation", c.anchor_min_translation, nullptr,
     "the first motion's translation anchors the world (frame 0's start) above this, m per frame");
   v("anchor_min_rotation", c.anchor_min_rotation, nullptr,

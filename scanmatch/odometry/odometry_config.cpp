@@ -53,6 +53,9 @@ void check_odometry_config(const OdometryConfig& c) {
   if (!(c.redeskew_translation >= 0.0) || !(c.redeskew_rotation >= 0.0))
     throw Error("odometry: redeskew_translation and redeskew_rotation must not be negative");
   positive(c.prior_miss_angle, "prior_miss_angle");
+  positive(c.spin_period, "spin_period");
+  if (!std::isfinite(c.spin_start_azimuth))
+    throw Error("odometry: spin_start_azimuth must be finite (radians)");
 }
 
 }  // namespace scanmatch

@@ -2,6 +2,7 @@
 // The configuration of the 3D odometry (every pipeline and stage reads its part of it). Each field
 // is described once, with its JSON key and flag, in config_fields.hpp.
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -69,6 +70,16 @@ struct OdometryConfig {
   /// them. Both 0: never (and the first frames stay as they are).
   double redeskew_translation = 0.05;  ///< m per frame
   double redeskew_rotation = 0.0175;   ///< rad per frame (1 deg)
+  /// Frames that carry no point times get them from each point's azimuth (spin_times.hpp) before
+  /// preprocessing, as a spinning sensor measured them, so they are deskewed too; frames with
+  /// times keep theirs. Off by default: a cloud does not say whether its sweep is raw or already
+  /// deskewed (KITTI's odometry benchmark scans were motion-compensated by the data set, its raw
+  /// scans were not; both are .bin files without times).
+  bool spin_times = false;
+  double spin_period = 0.1;  ///< s per turn of the sensor
+  /// rad: where each sweep starts (atan2(y, x), 0 along +x): behind the sensor, as KITTI's scans.
+  double spin_start_azimuth = M_PI;
+  bool spin_clockwise = true;  ///< seen from above (Velodyne sensors turn clockwise)
   /// The world is frame 0's start, half of frame 0's motion before the internal origin (its
   /// middle), known only from the first measured motions. Each part of that motion anchors the
   /// world only above these: a wrong rotation turns every later pose about the start (a ground

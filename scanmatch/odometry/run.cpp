@@ -22,6 +22,7 @@
 #include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/health.hpp"
+#include "scanmatch/odometry/spin_times.hpp"
 
 namespace scanmatch {
 namespace {
@@ -303,6 +304,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   ProgressReporter progress("odometry " + config.method, total, "frames", options.quiet);
   Frame frame;
   double pipeline_ms = 0.0;
+  const SpinTiming spin_timing{config.spin_period, config.spin_start_azimuth,
+                               config.spin_clockwise};
   const Stopwatch run_time;
   while (summary.frames < total) {
     if (options.stop && options.stop->load()) {
@@ -315,6 +318,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       summary.error = e.what();  // the run ends here, keeping what it finished
       break;
     }
+    if (config.spin_times && !frame.cloud.has_time())
+      assign_azimuth_times(frame.cloud, spin_timing);
     const Pose pose = odometry->register_frame(frame.cloud, frame.timestamp);
     const FrameStats& s = odometry->last_stats();
     pipeline_ms += s.total_ms;
