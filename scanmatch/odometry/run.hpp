@@ -104,6 +104,8 @@ struct RunSummary {
 /// Bad frames (empty, unreadable) are reported on stderr and bridged, never fatal; a frame the
 /// source cannot deliver at all (Error from next(), e.g. a truncated file) ends the run: RUNDIR
 /// is finished for the frames before it (summary.json with "error"), then that Error is thrown.
+/// With config.spin_times, frames without point times get them from azimuth (spin_times.hpp)
+/// before the odometry sees them.
 RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                         const RunOptions& options);
 
