@@ -5,8 +5,6 @@
 
 #include <cmath>
 
-#include <cmath>
-
 #include "scanmatch/core/point_cloud.hpp"
 
 namespace scanmatch {
