@@ -102,11 +102,11 @@ Pose2 Mapper2D::prior_along_open_direction(const Scan2D& current, const Referenc
   // Registered again from there for the rotation and the across direction (the spread's axis is
   // a cell-resolution estimate, a few degrees off: a metre along it drifts centimetres across),
   // keeping only the across part of what the registration moves.
+  Registration2DOptions fine = config_.registration;
+  fine.search_window = 0.0;  // the method's own coarse stage, as without the search
   Pose2 refined = shifted;
   try {
-    refined = registration_2d_method(config_.registration.method)
-                  .run(current, reference, config_.registration, shifted)
-                  .transform;
+    refined = registration_2d_method(fine.method).run(current, reference, fine, shifted).transform;
   } catch (const Error&) {
     // Too few usable points to register again: the shifted pose stands.
   }
