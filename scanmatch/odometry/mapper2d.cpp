@@ -157,13 +157,10 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
       const CorrelativeGrid grid(reference, o.search_resolution, o.search_fill_gap);
       // Each search's score (correlative_match's share) beside its refined pose.
       double score = 0.0;
-      const auto search = [&](const Eigen::Vector2d& window, double angle, double& searched_score) {
-        const CorrelativeMatch match = correlative_match(current, grid, guess, window, angle);
-        searched_score = match.score;
-        return refine_searched(current, prepared, o, match.pose);
-      };
       const Eigen::Vector2d window = Eigen::Vector2d::Constant(o.search_window);
-      r = search(window, o.search_angle, score);
+      CorrelativeMatch match = correlative_match(current, grid, guess, window, o.search_angle);
+      score = match.score;
+      r = refine_searched(current, prepared, o, match.pose);
       // A turn beyond the search's angle window leaves most points off the reference.
       const ScanFit fit(reference, o.search_fill_gap);
       double best = fit(current, r.transform);
@@ -171,14 +168,19 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
       // With `score_margin`, also where its search scored that much more and as many points fit.
       const auto search_wider = [&](const Eigen::Vector2d& wider_window, double angle,
                                     double score_margin = 1.0) {
-        double wider_score = 0.0;
-        const Registration2DResult w = search(wider_window, angle, wider_score);
+        // Every wider window here holds the first search's, so its best scores at least as
+        // high: poses below the best score so far need no look (the bounds prune from the
+        // start), and where none reaches it the best so far stands.
+        match = correlative_match(current, grid, guess, wider_window, angle,
+                                  std::clamp(score, 0.0, 1.0));
+        if (!match.found) return false;
+        const Registration2DResult w = refine_searched(current, prepared, o, match.pose);
         const double fitted = fit(current, w.transform);
-        if (fitted <= best + 0.05 && !(wider_score > score + score_margin && fitted >= best))
+        if (fitted <= best + 0.05 && !(match.score > score + score_margin && fitted >= best))
           return false;
         r = w;
         best = fitted;
-        score = wider_score;
+        score = match.score;
         return true;
       };
       const bool wide = config_.wide_search_angle > o.search_angle;
