@@ -339,6 +339,44 @@ TEST(Scan2D, CorrelativeMatchScoresTheFitAndGivesUpBelowItsMinimum) {
   EXPECT_THROW(correlative_match(current, reference, guess, 1.0, 0.5, 0.05, 0.0, 1.5), Error);
 }
 
+TEST(Scan2D, CorrelativeGridServesEverySearchOntoItsReference) {
+  // The odometry builds one grid per step for its narrow, wide, whole-turn and long searches. Onto
+  // it a search finds what the search from the scan finds: the same truth, within a cell (the
+  // grid spans the whole reference, so its cells may lie differently), at the same score.
+  int within = 0, total = 0;
+  for (const sim::PlanarScanPair& laser : pairs(scanmatch::testing::sanitized() ? 10 : 40)) {
+    const Scan2D reference = scan_from_laser(laser.reference),
+                 current = scan_from_laser(laser.current);
+    const CorrelativeGrid grid(reference, 0.05, 1.0);
+    ASSERT_FALSE(grid.empty());
+    const CorrelativeMatch from_scan =
+        correlative_match(current, reference, Pose2::Identity(), 0.5, 0.3, 0.05, 1.0);
+    const CorrelativeMatch from_grid =
+        correlative_match(current, grid, Pose2::Identity(), 0.5, 0.3);
+    ++total;
+    within += (from_grid.pose.translation() - from_scan.pose.translation()).norm() <= 0.075 &&
+              std::abs(pose2_angle(from_grid.pose.inverse() * from_scan.pose)) <= 0.02;
+    EXPECT_LT((from_grid.pose.translation() - laser.truth.translation()).norm(), 0.1);
+    EXPECT_NEAR(from_grid.score, from_scan.score, 0.05);
+    const CorrelativeSpread spread = correlative_spread(
+        current, CorrelativeGrid(reference, 0.1, 1.0), from_grid.pose, 0.5, 0.03, 0.05);
+    EXPECT_GT(spread.poses, 0u);
+    EXPECT_LT(widest_spread(spread).rms, 0.3);  // the rooms fix every step
+  }
+  EXPECT_GE(within, total * 9 / 10);
+  // An empty reference gives an empty grid: nothing found, the guess handed back.
+  const CorrelativeGrid empty(Scan2D{}, 0.05);
+  EXPECT_TRUE(empty.empty());
+  const Pose2 guess = pose2(0.3, 0.1, 0.2);
+  const CorrelativeMatch none =
+      correlative_match(scan_from_laser(pairs(1).front().current), empty, guess, 1.0, 0.5);
+  EXPECT_FALSE(none.found);
+  EXPECT_TRUE(none.pose.isApprox(guess));
+  EXPECT_THROW(CorrelativeGrid(scan_from_laser(pairs(1).front().reference), 0.0), Error);
+  EXPECT_THROW(correlative_match(scan_from_laser(pairs(1).front().current), empty, guess, 0.0, 0.5),
+               Error);
+}
+
 TEST(Scan2D, CorrelativeSpreadIsLongAlongACorridorAndShowsABetterPoseElsewhere) {
   const auto largest = [](const CorrelativeSpread& s) {
     return std::sqrt(
@@ -664,6 +702,81 @@ TEST(Map2D, SimulatedCorridorsKeepTheirStepsAndTurnTheirCorners) {
   EXPECT_LT(prior, 0.25);  // 0.18 before the fine stage's fit check, 0.226 with it (seeds 2-5 gain)
   EXPECT_LT(prior, 0.8 * left);
   EXPECT_GT(ungated, 2.0 * prior);
+}
+
+namespace {
+
+/// Steps whose translation is off by more than 0.3 m or whose heading is off by more than 3 deg,
+/// of a Mapper2D run over `scans` against their poses.
+int off_steps(const Mapper2DConfig& config, const std::vector<LaserScan2D>& scans) {
+  Mapper2D mapper(config);
+  int off = 0;
+  Pose2 previous = mapper.add_scan(scan_from_laser(scans.front()), 0.0);
+  for (std::size_t i = 1; i < scans.size(); ++i) {
+    const Pose2 pose = mapper.add_scan(scan_from_laser(scans[i]), 0.0);
+    const Pose2 truth = pose2(scans[i - 1].pose).inverse() * pose2(scans[i].pose);
+    const Pose2 error = truth.inverse() * previous.inverse() * pose;
+    off += error.translation().norm() > 0.3 || std::abs(degrees(pose2_angle(error))) > 3.0;
+    previous = pose;
+  }
+  return off;
+}
+
+}  // namespace
+
+TEST(Map2D, LongSearchFindsAStepBeyondTheWindow) {
+  // orebro keeps a scan every 1 to 3 m: a step of 2-3 m follows one of 1 m or a turn on the spot,
+  // and the true step lies beyond the search's +-1.3 m of the motion prior. In the room, a 2.6 m
+  // step from the identity guess: within the window only a wrong pose fits (few points), the
+  // long search finds the step.
+  const Pose2 start = pose2(0.8, 1.0, 0.0), moved = pose2(3.4, 1.3, 0.1);
+  Mapper2DConfig config;
+  config.constant_velocity = false;
+  config.registration.search_window = 1.3;    // map2d's default
+  ASSERT_GT(config.long_search_window, 3.0);  // on by default
+  const auto second_step = [&](const Mapper2DConfig& c, bool* searched = nullptr) {
+    Mapper2D mapper(c);
+    mapper.add_scan(room_scan(start));
+    const Pose2 pose = mapper.add_scan(room_scan(moved));
+    if (searched) *searched = mapper.last_stats().long_search_won;
+    return pose;
+  };
+  const Pose2 truth = start.inverse() * moved;
+  bool won = false;
+  const Pose2 long_searched = second_step(config, &won);
+  EXPECT_TRUE(won);
+  EXPECT_LT((long_searched.translation() - truth.translation()).norm(), 0.05);
+  EXPECT_NEAR(pose2_angle(long_searched), 0.1, 0.01);
+  config.long_search_window = 0.0;
+  const Pose2 windowed = second_step(config);
+  EXPECT_GT((windowed.translation() - truth.translation()).norm(), 0.5);
+  // A step within the window fits well from the first search: no long search.
+  config = Mapper2DConfig{};
+  config.constant_velocity = false;
+  config.registration.search_window = 1.3;
+  Mapper2D mapper(config);
+  mapper.add_scan(room_scan(start));
+  mapper.add_scan(room_scan(pose2(1.2, 1.1, 0.05)));
+  EXPECT_FALSE(mapper.last_stats().long_search);
+}
+
+TEST(Map2D, LongSearchKeepsOrebrosCorridorSteps) {
+  // orebro scans 24-40: a turn on the spot, then 2-3 m steps down a corridor (26 -> 27 ... 32 ->
+  // 33). Without the long search the first step after the turn slides to 0.15 m where the robot
+  // drove 2 m, and each slid step makes the next guess short again (six steps of 2-3 m came out
+  // below 0.2 m, the southern wing's missing 12 m).
+  const std::string log = scanmatch::testing::shared_data("data/2d/carmen/orebro-corrected.log.gz");
+  if (log.empty()) GTEST_SKIP() << "../shared/data/2d/carmen is absent";
+  Scans2D input = load_scans_2d(log, {}, 41);
+  ASSERT_EQ(input.scans.size(), 41u);
+  const std::vector<LaserScan2D> scans(input.scans.begin() + 24, input.scans.end());
+  Mapper2DConfig config;
+  config.registration.search_window = 1.3;
+  const int with_long = off_steps(config, scans);
+  config.long_search_window = 0.0;
+  const int without = off_steps(config, scans);
+  EXPECT_GE(without, 4);
+  EXPECT_EQ(with_long, 0);
 }
 
 TEST(Map2D, MapperRefusesOptionsOutOfRangeBeforeTheFirstScan) {

@@ -7,9 +7,12 @@
 #include <string>
 
 #include "scanmatch/core/scan2d.hpp"
+#include "scanmatch/registration/planar/correlative_search.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
 namespace scanmatch {
+
+class Reference2D;  // registration/planar/reference2d.hpp
 
 struct Mapper2DConfig {
   Registration2DOptions registration;
@@ -67,6 +70,15 @@ struct Mapper2DConfig {
   double open_step_margin = 0.05;
   double open_step_spread = 0.3;
   double open_step_prior_distance = 0.5;
+  /// With the correlative search on, a search over +- this translation ahead and behind (m, about
+  /// the motion prior along the previous scan's heading; sideways as far as the first search, over
+  /// the wide search's angle) where the searches above leave the step weak (fewer than
+  /// `long_search_below` of the points fit) or open (open_step_spread): the robot moved farther
+  /// than the prior says. It wins by the same 5 % of the points. A log that keeps a scan every 1
+  /// to 3 m (orebro) steps 2-3 m where the previous step was 1 m, or where the previous step slid
+  /// short along a corridor; within +-1.3 m of that prior only a wrong pose fits. 0: off.
+  double long_search_window = 3.5;
+  double long_search_below = 0.7;
 };
 
 struct Scan2DStats {
@@ -77,9 +89,14 @@ struct Scan2DStats {
   bool bridged = false;  ///< the scan could not be registered: the motion prior was used
   /// The scans left the step open and the motion prior chose along it (open_step_window).
   bool open_step_from_prior = false;
+  /// The long search ran (long_search_window), and whether its pose won.
+  bool long_search = false, long_search_won = false;
   /// Few points fit even after the wide search (full_turn_search_below): the step's rotation is
   /// in doubt, whichever search won.
   bool weak_fit = false;
+  /// Share of the points within 15 cm of the reference's surfaces at the searched pose (before
+  /// the fine stage); -1 where no search ran. The step's health beside its error.
+  double fit = -1.0;
 };
 
 class Mapper2D {
@@ -97,12 +114,14 @@ class Mapper2D {
   std::size_t scans() const { return scans_; }
 
  private:
-  /// `whole_turn`: the correlative search looked over every rotation, so any turn is plausible.
-  bool plausible_correction(const Pose2& correction, bool whole_turn) const;
-  /// `registered` moved along the direction the scans leave open (if they do) to the fitting
-  /// translation nearest the motion prior `guess` (open_step_window).
-  Pose2 prior_along_open_direction(const Scan2D& current, const Scan2D& reference,
-                                   const Pose2& registered, const Pose2& guess);
+  /// `whole_turn`: the correlative search looked over every rotation, so any turn is plausible;
+  /// `window`: the translation window (m) the winning search looked over.
+  bool plausible_correction(const Pose2& correction, bool whole_turn, double window) const;
+  /// `registered` moved along the direction the scans leave open (`spread` about it, if they do)
+  /// to the fitting translation nearest the motion prior `guess` (open_step_window).
+  Pose2 prior_along_open_direction(const Scan2D& current, const Reference2D& reference,
+                                   const CorrelativeSpread& spread, const Pose2& registered,
+                                   const Pose2& guess);
 
   Mapper2DConfig config_;
   Scan2D keyframe_, last_scan_;

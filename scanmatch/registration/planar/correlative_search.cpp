@@ -107,9 +107,10 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
       }
     }
     std::vector<float>& out = g.levels[level];
-    out = rows;
+    out.resize(n);
     for (std::size_t y = 0; y < static_cast<std::size_t>(g.height); ++y) {
       float* row = out.data() + y * width;
+      std::copy(rows.data() + y * width, rows.data() + (y + 1) * width, row);
       for (std::size_t k = 1; k < kBranch; ++k) {
         const std::size_t other = y + k * stride;
         if (other >= static_cast<std::size_t>(g.height)) break;
@@ -164,45 +165,49 @@ bool higher_bound(const Block& a, const Block& b) {
 /// and the thinned points' cells under each rotation. Empty `cells` when nothing can be scored.
 struct SearchSpace {
   std::vector<Vec2> points;
-  LikelihoodGrid grid;
+  std::shared_ptr<const LikelihoodGrid> grid_owner;
+  const LikelihoodGrid* grid_ = nullptr;
   Pose2 initial = Pose2::Identity();
   double angle_step = 0.0;
-  int angles = 0;  ///< rotations -angles..angles steps about the initial guess
-  int half = 0;    ///< translations -half..half cells about it
-  int span = 0;    ///< 2 * half + 1
+  int angles = 0;              ///< rotations -angles..angles steps about the initial guess
+  int half_x = 0, half_y = 0;  ///< translations -half..half cells about it, along x and y
+  int span_x = 0, span_y = 0;  ///< 2 * half + 1
   std::vector<std::vector<std::pair<int, int>>> cells;  ///< per rotation, relative to -half
 
   /// Sum over the points of the level's likelihood, at translation cell (x, y) (0..span-1).
   float score(int angle, int level, int x, int y) const {
     float sum = 0.0f;
     for (const auto& [cx, cy] : cells[static_cast<std::size_t>(angle + angles)])
-      sum += grid.at(level, cx + x, cy + y);
+      sum += grid_->at(level, cx + x, cy + y);
     return sum;
   }
+  const LikelihoodGrid& grid() const { return *grid_; }
   Pose2 pose(int angle, int x, int y) const {
-    const double r = grid.resolution;
-    return pose2(initial.translation().x() + (x - half) * r,
-                 initial.translation().y() + (y - half) * r,
+    const double r = grid_->resolution;
+    return pose2(initial.translation().x() + (x - half_x) * r,
+                 initial.translation().y() + (y - half_y) * r,
                  pose2_angle(initial) + angle * angle_step);
   }
 };
 
-SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
-                         double window, double angle_window, double resolution, double fill_gap) {
-  SearchSpace space;
-  if (current.points.empty() || reference.points.empty()) return space;  // nothing to score
-  std::vector<Vec2>& points = space.points;
+/// The current scan's points (finite, thinned at `resolution`'s double) and their ranges' 90th
+/// percentile and maximum, for the search's angular step and the grid's footprint.
+struct SearchPoints {
+  std::vector<Vec2> points;
+  double step_range = 0.0, max_range = 0.0;
+};
+
+SearchPoints search_points(const Scan2D& current, double resolution) {
+  SearchPoints out;
+  std::vector<Vec2>& points = out.points;
   // A non-finite point lands nowhere; dropped here, before any conversion to a cell.
   std::vector<Vec2> finite;
   finite.reserve(current.points.size());
   for (const Vec2& p : current.points)
     if (p.allFinite()) finite.push_back(p);
   points = thinned(finite, 2 * resolution);
-  if (points.empty()) return space;
-
-  // The grid covers where the current scan can land: its footprint under the initial guess,
-  // grown by the window and the rotation's sweep.
-  double max_range = 0.0;
+  if (points.empty()) return out;
+  double& max_range = out.max_range;
   std::vector<double> ranges;
   ranges.reserve(points.size());
   for (const Vec2& p : points) {
@@ -214,31 +219,32 @@ SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const P
   // this searched 1.7x faster with the same failures (27 / 69 / 9 against 27 / 68 / 10).
   const auto percentile = ranges.begin() + static_cast<std::ptrdiff_t>(ranges.size() * 9 / 10);
   std::nth_element(ranges.begin(), percentile, ranges.end());
-  const double step_range = *percentile;
-  Vec2 low = initial.translation(), high = initial.translation();
-  for (const Vec2& p : points) {
-    const Vec2 q = initial * p;
-    low = low.cwiseMin(q);
-    high = high.cwiseMax(q);
-  }
-  const double margin = window + std::min(max_range, max_range * angle_window) + 4 * resolution;
-  low -= Vec2::Constant(margin);
-  high += Vec2::Constant(margin);
-  std::vector<Vec2> useful;
-  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
-    if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
-  if (useful.empty()) return space;
-  space.grid = make_grid(useful, resolution);
-  const LikelihoodGrid& g = space.grid;
+  out.step_range = *percentile;
+  return out;
+}
+
+/// The rotations and translations of a search about `initial` onto `grid`, with the cells of the
+/// points under each rotation.
+SearchSpace search_space(SearchPoints&& current, std::shared_ptr<const LikelihoodGrid> grid,
+                         const Pose2& initial, const Vec2& window, double angle_window) {
+  SearchSpace space;
+  space.points = std::move(current.points);
+  const std::vector<Vec2>& points = space.points;
+  space.grid_owner = std::move(grid);
+  space.grid_ = space.grid_owner.get();
+  const LikelihoodGrid& g = *space.grid_;
   const double r = g.resolution;
+  const double step_range = current.step_range;
 
   // Angular step: a point at `step_range` moves by about one cell.
   space.angle_step = std::clamp(r / std::max(step_range, 1e-3), 0.1 * M_PI / 180, 1.0 * M_PI / 180);
   space.angles = static_cast<int>(std::ceil(angle_window / space.angle_step));
-  space.half = static_cast<int>(std::ceil(window / r));  // translations -half..half cells
-  space.span = 2 * space.half + 1;
+  space.half_x = static_cast<int>(std::ceil(window.x() / r));  // translations -half..half cells
+  space.half_y = static_cast<int>(std::ceil(window.y() / r));
+  space.span_x = 2 * space.half_x + 1;
+  space.span_y = 2 * space.half_y + 1;
   space.initial = initial;
-  const int angles = space.angles, half = space.half;
+  const int angles = space.angles, half_x = space.half_x, half_y = space.half_y;
 
   // Cells of the thinned points under each rotation, relative to the window's corner.
   space.cells.resize(static_cast<std::size_t>(2 * angles + 1));
@@ -246,7 +252,7 @@ SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const P
   // than std::floor, exact within 2^20 cells of the grid; farther (a wild point) is clamped, still
   // off the grid, where a conversion would overflow.
   constexpr double kShift = 1 << 20;
-  const auto cell = [&](double v) {
+  const auto cell = [&](double v, int half) {
     return static_cast<int>(std::clamp(v, -kShift, kShift) + kShift) - (1 << 20) - half;
   };
   const Vec2 start = (initial.translation() - g.origin) / r;
@@ -256,10 +262,65 @@ SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const P
     auto& out = space.cells[static_cast<std::size_t>(a + angles)];
     out.reserve(points.size());
     for (const Vec2& p : points)
-      out.push_back(
-          {cell(c * p.x() - s * p.y() + start.x()), cell(s * p.x() + c * p.y() + start.y())});
+      out.push_back({cell(c * p.x() - s * p.y() + start.x(), half_x),
+                     cell(s * p.x() + c * p.y() + start.y(), half_y)});
   }
   return space;
+}
+
+/// A search about `initial` onto `reference`'s filled surfaces where the current scan can land
+/// (its footprint under `initial`, grown by the window and the rotation's sweep). Empty `cells`
+/// when nothing can be scored.
+SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
+                         double window, double angle_window, double resolution, double fill_gap) {
+  if (current.points.empty() || reference.points.empty()) return {};  // nothing to score
+  SearchPoints points = search_points(current, resolution);
+  if (points.points.empty()) return {};
+  Vec2 low = initial.translation(), high = initial.translation();
+  for (const Vec2& p : points.points) {
+    const Vec2 q = initial * p;
+    low = low.cwiseMin(q);
+    high = high.cwiseMax(q);
+  }
+  const double margin =
+      window + std::min(points.max_range, points.max_range * angle_window) + 4 * resolution;
+  low -= Vec2::Constant(margin);
+  high += Vec2::Constant(margin);
+  std::vector<Vec2> useful;
+  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
+    if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
+  if (useful.empty()) return {};
+  return search_space(std::move(points),
+                      std::make_shared<LikelihoodGrid>(make_grid(useful, resolution)), initial,
+                      Vec2::Constant(window), angle_window);
+}
+
+}  // namespace
+
+struct CorrelativeGrid::Impl {
+  std::shared_ptr<const LikelihoodGrid> grid;
+};
+
+CorrelativeGrid::CorrelativeGrid(const Scan2D& reference, double resolution, double fill_gap)
+    : requested_resolution_(resolution) {
+  if (!(resolution > 0.0)) throw Error("correlative search: resolution must be positive");
+  std::vector<Vec2> surfaces;
+  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
+    if (q.allFinite()) surfaces.push_back(q);
+  if (surfaces.empty()) return;
+  auto impl = std::make_shared<Impl>();
+  impl->grid = std::make_shared<LikelihoodGrid>(make_grid(surfaces, resolution));
+  impl_ = std::move(impl);
+}
+
+namespace {
+
+SearchSpace search_space(const Scan2D& current, const CorrelativeGrid& reference,
+                         const Pose2& initial, const Vec2& window, double angle_window) {
+  if (current.points.empty() || reference.empty()) return {};
+  SearchPoints points = search_points(current, reference.resolution());
+  if (points.points.empty()) return {};
+  return search_space(std::move(points), reference.impl().grid, initial, window, angle_window);
 }
 
 }  // namespace
@@ -300,19 +361,21 @@ Pose2 correlative_search(const Scan2D& current, const Scan2D& reference, const P
       .pose;
 }
 
-CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& reference,
-                                   const Pose2& initial, double window, double angle_window,
-                                   double resolution, double fill_gap, double min_score) {
-  check_window(window, angle_window, resolution);
+namespace {
+
+void check_min_score(double min_score) {
   if (!(min_score >= 0.0 && min_score <= 1.0))
     throw Error("correlative search: the minimum score must be in [0, 1]");
+}
+
+/// correlative_match over a prepared search space.
+CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double min_score) {
   CorrelativeMatch match;
   match.pose = initial;
-  const SearchSpace space =
-      search_space(current, reference, initial, window, angle_window, resolution, fill_gap);
   if (space.cells.empty()) return match;
   const std::vector<Vec2>& points = space.points;
-  const int angles = space.angles, half = space.half, span = space.span;
+  const int angles = space.angles, half_x = space.half_x, half_y = space.half_y,
+            span_x = space.span_x, span_y = space.span_y;
   // Branch and bound, depth first: a block of translations is bounded by its level's maxima; the
   // children of the most promising blocks are looked at first, so the best score found early
   // dismisses most of the window. Exact at the finest level; ties go to the translation nearest
@@ -322,22 +385,22 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   };
   // The top level: the coarsest whose blocks still split the window.
   int top = kLevels - 1;
-  while (top > 0 && kSides[static_cast<std::size_t>(top - 1)] >= span) --top;
+  while (top > 0 && kSides[static_cast<std::size_t>(top - 1)] >= std::max(span_x, span_y)) --top;
   const int top_side = kSides[static_cast<std::size_t>(top)];
   std::vector<Block> blocks;
   for (int a = -angles; a <= angles; ++a)
-    for (int y = 0; y < span; y += top_side)
-      for (int x = 0; x < span; x += top_side) blocks.push_back(bound_of(a, top, x, y));
+    for (int y = 0; y < span_y; y += top_side)
+      for (int x = 0; x < span_x; x += top_side) blocks.push_back(bound_of(a, top, x, y));
   std::sort(blocks.begin(), blocks.end(), higher_bound);
   // Below the minimum nothing counts, so the bounds prune from the start.
   float best = static_cast<float>(min_score * static_cast<double>(points.size()));
-  int best_a = 0, best_x = half, best_y = half;
+  int best_a = 0, best_x = half_x, best_y = half_y;
   double best_offset = std::numeric_limits<double>::infinity();
   // A pose's exact score at the finest level; kept when it beats the best so far, or ties it
   // nearer the guess.
   const auto consider = [&](const Block& leaf) {
     if (leaf.bound < best) return;
-    const double offset = std::hypot(leaf.x - half, leaf.y - half) + std::abs(leaf.angle);
+    const double offset = std::hypot(leaf.x - half_x, leaf.y - half_y) + std::abs(leaf.angle);
     if (leaf.bound == best && offset >= best_offset) return;
     best = leaf.bound;
     best_offset = offset;
@@ -348,7 +411,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   // A good score early prunes most of the tree: climb from the guess (where odometry's constant
   // velocity guess and a loop's estimate usually lie close) before branching.
   {
-    Block here = bound_of(0, 0, half, half);
+    Block here = bound_of(0, 0, half_x, half_y);
     consider(here);
     for (int step = 0; step < 32; ++step) {
       Block up = here;
@@ -357,7 +420,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
           for (int dx = -1; dx <= 1; ++dx) {
             const int a = here.angle + da, x = here.x + dx, y = here.y + dy;
             if ((da == 0 && dx == 0 && dy == 0) || std::abs(a) > angles || x < 0 || y < 0 ||
-                x >= span || y >= span)
+                x >= span_x || y >= span_y)
               continue;
             const Block b = bound_of(a, 0, x, y);
             consider(b);
@@ -378,7 +441,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
     for (int dy = 0; dy < kBranch; ++dy)
       for (int dx = 0; dx < kBranch; ++dx) {
         const int x = block.x + dx * side, y = block.y + dy * side;
-        if (x < span && y < span) next[count++] = bound_of(block.angle, block.level - 1, x, y);
+        if (x < span_x && y < span_y) next[count++] = bound_of(block.angle, block.level - 1, x, y);
       }
     std::sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(count), higher_bound);
     for (std::size_t i = 0; i < count; ++i) {
@@ -397,16 +460,45 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
   return match;
 }
 
-CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
-                                     const Pose2& at, double window, double angle_window,
-                                     double resolution, double fill_gap, double margin,
-                                     const std::optional<Eigen::Vector2d>& toward) {
+}  // namespace
+
+CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& reference,
+                                   const Pose2& initial, double window, double angle_window,
+                                   double resolution, double fill_gap, double min_score) {
   check_window(window, angle_window, resolution);
+  check_min_score(min_score);
+  return best_in(
+      search_space(current, reference, initial, window, angle_window, resolution, fill_gap),
+      initial, min_score);
+}
+
+CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid& reference,
+                                   const Pose2& initial, double window, double angle_window,
+                                   double min_score) {
+  return correlative_match(current, reference, initial, Vec2::Constant(window), angle_window,
+                           min_score);
+}
+
+CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid& reference,
+                                   const Pose2& initial, const Eigen::Vector2d& window,
+                                   double angle_window, double min_score) {
+  check_window(std::min(window.x(), window.y()), angle_window, reference.resolution());
+  check_min_score(min_score);
+  return best_in(search_space(current, reference, initial, window, angle_window), initial,
+                 min_score);
+}
+
+namespace {
+
+void check_margin(double margin) {
   if (!(margin >= 0.0)) throw Error("correlative search: the margin must not be negative");
+}
+
+/// correlative_spread over a prepared search space.
+CorrelativeSpread spread_in(const SearchSpace& space, const Pose2& at, double margin,
+                            const std::optional<Eigen::Vector2d>& toward) {
   CorrelativeSpread spread;
   spread.nearest = at;
-  const SearchSpace space =
-      search_space(current, reference, at, window, angle_window, resolution, fill_gap);
   if (space.cells.empty()) return spread;
   // Each translation's best rotation. Blocks of 4 x 4 translations are bounded by the grid's first
   // max-filtered level and looked at best first; once a block's bound falls below the best found
@@ -416,19 +508,19 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
   constexpr int kLevel = 1, kSide = kSides[kLevel];
   std::vector<Block> blocks;
   for (int a = -space.angles; a <= space.angles; ++a)
-    for (int y = 0; y < space.span; y += kSide)
-      for (int x = 0; x < space.span; x += kSide)
+    for (int y = 0; y < space.span_y; y += kSide)
+      for (int x = 0; x < space.span_x; x += kSide)
         blocks.push_back({space.score(a, kLevel, x, y), a, kLevel, x, y});
   std::sort(blocks.begin(), blocks.end(), higher_bound);
-  const auto cells = static_cast<std::size_t>(space.span * space.span);
+  const auto cells = static_cast<std::size_t>(space.span_x * space.span_y);
   std::vector<float> best_of(cells, 0.0f);
   std::vector<int> best_angle(cells, 0);
   float best = 0.0f;
   for (const Block& block : blocks) {
     if (block.bound < best - allowance) break;
-    for (int y = block.y; y < std::min(block.y + kSide, space.span); ++y)
-      for (int x = block.x; x < std::min(block.x + kSide, space.span); ++x) {
-        const auto i = static_cast<std::size_t>(y * space.span + x);
+    for (int y = block.y; y < std::min(block.y + kSide, space.span_y); ++y)
+      for (int x = block.x; x < std::min(block.x + kSide, space.span_x); ++x) {
+        const auto i = static_cast<std::size_t>(y * space.span_x + x);
         const float score = space.score(block.angle, 0, x, y);
         if (score > best_of[i]) {
           best_of[i] = score;
@@ -439,13 +531,13 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
   }
   spread.best_score = best / points;
   const float threshold = best - allowance;
-  const double r = space.grid.resolution;
+  const double r = space.grid().resolution;
   double nearest = std::numeric_limits<double>::infinity();
-  for (int y = 0; y < space.span; ++y)
-    for (int x = 0; x < space.span; ++x) {
-      const auto i = static_cast<std::size_t>(y * space.span + x);
+  for (int y = 0; y < space.span_y; ++y)
+    for (int x = 0; x < space.span_x; ++x) {
+      const auto i = static_cast<std::size_t>(y * space.span_x + x);
       if (best_of[i] < threshold) continue;
-      const Eigen::Vector2d offset((x - space.half) * r, (y - space.half) * r);
+      const Eigen::Vector2d offset((x - space.half_x) * r, (y - space.half_y) * r);
       spread.second_moment += offset * offset.transpose();
       ++spread.poses;
       if (toward) {
@@ -458,6 +550,27 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
     }
   if (spread.poses > 0) spread.second_moment /= static_cast<double>(spread.poses);
   return spread;
+}
+
+}  // namespace
+
+CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
+                                     const Pose2& at, double window, double angle_window,
+                                     double resolution, double fill_gap, double margin,
+                                     const std::optional<Eigen::Vector2d>& toward) {
+  check_window(window, angle_window, resolution);
+  check_margin(margin);
+  return spread_in(search_space(current, reference, at, window, angle_window, resolution, fill_gap),
+                   at, margin, toward);
+}
+
+CorrelativeSpread correlative_spread(const Scan2D& current, const CorrelativeGrid& reference,
+                                     const Pose2& at, double window, double angle_window,
+                                     double margin, const std::optional<Eigen::Vector2d>& toward) {
+  check_window(window, angle_window, reference.resolution());
+  check_margin(margin);
+  return spread_in(search_space(current, reference, at, Vec2::Constant(window), angle_window), at,
+                   margin, toward);
 }
 
 SpreadAxis widest_spread(const CorrelativeSpread& spread) {

@@ -7,11 +7,35 @@
 // register_scans runs it first when Registration2DOptions::search_window is set.
 
 #include <cmath>
+#include <memory>
 #include <optional>
 
 #include "scanmatch/core/scan2d.hpp"
 
 namespace scanmatch {
+
+/// A reference's likelihood grid built once for several searches onto it (the odometry searches
+/// each step over +-45 deg, +-90 deg and sometimes the whole turn, and looks at the step's spread):
+/// building the grid was half of a step's time on long-range logs (freiburg-campus, acapulco).
+/// Spans all of the reference's (filled) surfaces; `resolution` m, coarser where the area is huge.
+/// Cheap to copy (shared, immutable).
+class CorrelativeGrid {
+ public:
+  /// Throws Error unless `resolution` is positive. An empty reference gives an empty grid, onto
+  /// which no search finds anything.
+  CorrelativeGrid(const Scan2D& reference, double resolution, double fill_gap = 0.0);
+  bool empty() const { return impl_ == nullptr; }
+  double resolution() const {
+    return requested_resolution_;
+  }  ///< as asked (the grid may be coarser)
+
+  struct Impl;  // the grid and its max-filtered levels (correlative_search.cpp)
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::shared_ptr<const Impl> impl_;
+  double requested_resolution_ = 0.05;
+};
 
 /// The pose within +- `window` (m, in x and y) and +- `angle_window` (rad) of `initial` whose
 /// transformed points best hit a smoothed likelihood grid of the reference, found exactly at the
@@ -38,6 +62,16 @@ CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& referenc
                                    const Pose2& initial, double window, double angle_window,
                                    double resolution = 0.05, double fill_gap = 0.0,
                                    double min_score = 0.0);
+
+/// correlative_match onto a prepared grid (its resolution and fill as it was built with).
+CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid& reference,
+                                   const Pose2& initial, double window, double angle_window,
+                                   double min_score = 0.0);
+/// The same over a rectangular window: +- window.x() and +- window.y() (m) along the
+/// reference's axes (the odometry's long search reaches far ahead, not sideways).
+CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid& reference,
+                                   const Pose2& initial, const Eigen::Vector2d& window,
+                                   double angle_window, double min_score = 0.0);
 
 /// How much a scan's translation is left open at a pose (`at`, current in the reference's frame):
 /// the translations within +- `window` (m) of it, each at its best rotation within
@@ -66,6 +100,11 @@ inline constexpr double kStepSpreadResolution = 0.1;
 CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& reference,
                                      const Pose2& at, double window, double angle_window,
                                      double resolution, double fill_gap, double margin,
+                                     const std::optional<Eigen::Vector2d>& toward = std::nullopt);
+/// correlative_spread onto a prepared grid.
+CorrelativeSpread correlative_spread(const Scan2D& current, const CorrelativeGrid& reference,
+                                     const Pose2& at, double window, double angle_window,
+                                     double margin,
                                      const std::optional<Eigen::Vector2d>& toward = std::nullopt);
 
 /// The direction the counted translations spread most along (unit; any when none counted) and
