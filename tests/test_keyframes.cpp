@@ -339,6 +339,50 @@ TEST(AdaptiveRules, ATurnedStartRecoversAPriorThatMissedTheTurn) {
   EXPECT_GT(error_deg(unturned), 3.0);  // measured 8.1 deg
 }
 
+TEST(AdaptiveRules, RankedStartsRecoverTheTurnWithFewerFullSolves) {
+  const std::string folder = scanmatch::testing::shared_data("data/3d/avia_hku1");
+  if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
+  // The keyframes and the prior 15 degrees off of the test above. Ranking the starts on a subset
+  // of the coarse points first (start_screen_points) must pick the turned start that solving
+  // every start on every point picks, at a fraction of the solves on every point.
+  const std::size_t a = 12, b = 13;
+  const auto frame_at = [&](std::size_t i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "/frames/%06zu.pcd", i);
+    return voxel_downsample(read_cloud(folder + name), 0.25);
+  };
+  const Trajectory reference = read_trajectory(folder + "/odom_poses.txt");
+  const Pose truth = reference.poses[a].inverse() * reference.poses[b];
+  MotionPrior prior;
+  prior.uncertain = true;
+  prior.motion = truth;
+  prior.motion.linear() =
+      truth.linear() * Eigen::AngleAxisd(0.26, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const auto align = [&](std::uint32_t screen_points) {
+    OdometryConfig c;
+    c.start_screen_points = screen_points;
+    CoarseNdt coarse(c);
+    coarse.set_reference(frame_at(a), false);
+    return coarse.align(frame_at(b), prior);
+  };
+  const CoarseResult ranked = align(150);
+  const CoarseResult every = align(0);
+  const Pose between = every.motion.inverse() * ranked.motion;
+  std::printf(
+      "[ ranked ] %.3f deg %.4f m from solving every start; iterations on every point "
+      "%d (every start: %d), on the subset %d\n",
+      rotation_angle(between) * kDegreesPerRadian, between.translation().norm(), ranked.iterations,
+      every.iterations, ranked.screen_iterations);
+  EXPECT_TRUE(every.recovered);
+  EXPECT_TRUE(ranked.recovered);
+  EXPECT_LT(rotation_angle(between) * kDegreesPerRadian, 0.2);
+  EXPECT_LT(between.translation().norm(), 0.02);
+  EXPECT_LT(rotation_angle(truth.inverse() * ranked.motion) * kDegreesPerRadian, 1.0);
+  EXPECT_EQ(every.screen_iterations, 0);
+  EXPECT_GT(ranked.screen_iterations, 0);
+  EXPECT_LT(ranked.iterations, every.iterations / 2);
+}
+
 TEST(AdaptiveRules, AWideStartRecoversACarEnteringATurn) {
   // urban-hdl64 frames 216 -> 217: the car (8 m/s) enters a 12 m turn at the crossing and turns
   // 3.2 deg in the step, while the constant-velocity prior (the straight step before) turns none.

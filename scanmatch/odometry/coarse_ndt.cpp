@@ -1,6 +1,8 @@
 #include "scanmatch/odometry/coarse_ndt.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "scanmatch/geometry/voxel_filter.hpp"
@@ -18,6 +20,17 @@ GaussianVoxelMapOptions grid_options(double resolution) {
   GaussianVoxelMapOptions o;
   o.voxel_size = resolution;
   return o;
+}
+
+/// The NDT factor of `source` on `grid`, with a voxel hint per point when each point looks up one
+/// voxel: every solve and score on the factor then skips the hash probe of a point whose voxel
+/// has not changed since the last (results do not change).
+NdtFactor hinted_factor(const PointCloud& source, const GaussianVoxelMap& grid,
+                        const OdometryConfig& config) {
+  NdtFactor factor =
+      ndt_factor(source, grid, config.ndt_neighbours, config.registration.ndt_outlier_ratio);
+  if (config.ndt_neighbours == 1) factor.hints.resize(source.size());
+  return factor;
 }
 
 bool near(const Pose& a, const Pose& b) {
@@ -47,9 +60,7 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
                                  ? voxel_downsample(frame, config_.coarse_voxel_size)
                                  : PointCloud{};
   const PointCloud& source = sparser.empty() ? frame : sparser;
-  NdtFactor factor =
-      ndt_factor(source, grid_, config_.ndt_neighbours, config_.registration.ndt_outlier_ratio);
-  if (config_.ndt_neighbours == 1) factor.hints.resize(source.size());
+  const NdtFactor factor = hinted_factor(source, grid_, config_);
   const RegistrationResult plain = optimize(factor, prior.motion, solver_);
   result.iterations = plain.iterations;
   result.condition_number = plain.condition_number;
@@ -60,7 +71,7 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
       config_.wide_start_iterations > 0 && plain.iterations >= config_.wide_start_iterations;
   if (prior.uncertain || slow)
     result.motion = best_start(source, result.motion, prior.motion, prior.uncertain,
-                               result.iterations, result.recovered);
+                               result.iterations, result.screen_iterations, result.recovered);
   return result;
 }
 
@@ -83,10 +94,10 @@ std::vector<Pose> CoarseNdt::other_starts(const Pose& prior_motion, bool uncerta
 }
 
 Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                           bool uncertain, int& iterations, bool& recovered) const {
+                           bool uncertain, int& iterations, int& screen_iterations,
+                           bool& recovered) const {
   if ((uncertain && !config_.uncertain_starts) || reference_.empty()) return plain;
-  const double outliers = config_.registration.ndt_outlier_ratio;
-  const NdtFactor normal = ndt_factor(source, grid_, config_.ndt_neighbours, outliers);
+  const NdtFactor normal = hinted_factor(source, grid_, config_);
   const auto score = [&](const Pose& motion, std::size_t& inliers) {
     const LinearSystem s = linearize_all(normal, motion, solver_);
     inliers = s.inliers;
@@ -102,20 +113,29 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
     wide_grid_.emplace(grid_options(config_.ndt_resolution * config_.uncertain_ndt_scale));
     wide_grid_->insert(reference_);
   }
-  const NdtFactor widened_factor =
-      ndt_factor(source, *wide_grid_, config_.ndt_neighbours, outliers);
+  const NdtFactor widened_factor = hinted_factor(source, *wide_grid_, config_);
 
-  std::vector<Pose> tried;
+  std::vector<Pose> starts;
   for (const Pose& start : other_starts(prior_motion, uncertain)) {
     bool seen = false;
-    for (const Pose& t : tried) seen = seen || near(t, start);
-    if (seen) continue;
-    tried.push_back(start);
-    const RegistrationResult widened = optimize(widened_factor, start, solver_);
-    iterations += widened.iterations;
-    if (widened.inliers < kMinimumFramePoints || !to_matrix(widened.transform).allFinite())
-      continue;
-    const RegistrationResult refined = optimize(normal, widened.transform, solver_);
+    for (const Pose& t : starts) seen = seen || near(t, start);
+    if (!seen) starts.push_back(start);
+  }
+  // Each start solved on every point from its own pose: the old way, and the fallback.
+  bool from_wide_grid = true;
+  if (should_screen(starts.size(), source.size()))
+    starts = screened_starts(source, starts, plain, screen_iterations, from_wide_grid);
+
+  for (const Pose& start : starts) {
+    Pose refined_start = start;
+    if (from_wide_grid) {
+      const RegistrationResult widened = optimize(widened_factor, start, solver_);
+      iterations += widened.iterations;
+      if (widened.inliers < kMinimumFramePoints || !to_matrix(widened.transform).allFinite())
+        continue;
+      refined_start = widened.transform;
+    }
+    const RegistrationResult refined = optimize(normal, refined_start, solver_);
     iterations += refined.iterations;
     if (!to_matrix(refined.transform).allFinite()) continue;
     const double cost = score(refined.transform, inliers);
@@ -125,6 +145,58 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
       recovered = true;
     }
   }
+  return best;
+}
+
+bool CoarseNdt::should_screen(std::size_t start_count, std::size_t source_points) const {
+  return config_.start_screen_points > 0 && config_.start_full_solves > 0 &&
+         start_count > static_cast<std::size_t>(config_.start_full_solves) &&
+         source_points >= 2 * config_.start_screen_points &&
+         config_.start_screen_points >= 2 * kMinimumFramePoints;
+}
+
+std::vector<Pose> CoarseNdt::screened_starts(const PointCloud& source,
+                                             const std::vector<Pose>& starts, const Pose& plain,
+                                             int& screen_iterations, bool& from_wide_grid) const {
+  // Every stride-th point: the source is already one point per coarse voxel, so the subset stays
+  // spread over the scene.
+  const std::size_t stride = source.size() / config_.start_screen_points;
+  std::vector<std::size_t> kept;
+  for (std::size_t i = 0; i < source.size(); i += stride) kept.push_back(i);
+  const PointCloud subset = select(source, kept);
+  const NdtFactor normal = hinted_factor(subset, grid_, config_);
+  const NdtFactor widened = hinted_factor(subset, *wide_grid_, config_);
+  const auto subset_cost = [&](const Pose& motion) {
+    const LinearSystem s = linearize_all(normal, motion, solver_);
+    return s.inliers >= kMinimumFramePoints ? s.cost : 0.0;
+  };
+  // Only starts that beat the plain result on the subset are worth a solve on every point.
+  const double plain_cost = subset_cost(plain);
+  std::vector<std::pair<double, Pose>> ranked;
+  for (const Pose& start : starts) {
+    const RegistrationResult wide = optimize(widened, start, solver_);
+    screen_iterations += wide.iterations;
+    if (!to_matrix(wide.transform).allFinite()) continue;
+    const RegistrationResult result = optimize(normal, wide.transform, solver_);
+    screen_iterations += result.iterations;
+    // Not skipped when near the plain result: on recorded keyframes the plain solve often stops a
+    // centimetre or two short, and the solve from the screened pose gets there (avia_hku1: ATE
+    // 0.11 % of the path with them skipped, 0.075 % kept).
+    if (!to_matrix(result.transform).allFinite()) continue;
+    const double cost = subset_cost(result.transform);
+    if (cost < plain_cost) ranked.emplace_back(cost, result.transform);
+  }
+  std::sort(ranked.begin(), ranked.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Pose> best;
+  for (const auto& [cost, motion] : ranked) {
+    if (best.size() >= static_cast<std::size_t>(config_.start_full_solves)) break;
+    bool seen = false;
+    for (const Pose& b : best) seen = seen || near(b, motion);
+    if (!seen) best.push_back(motion);
+  }
+  // The screened poses are already in the normal grid's basin.
+  from_wide_grid = false;
   return best;
 }
 

@@ -7,9 +7,12 @@
 // twice the prior, and the prior turned about the sensor's z axis by +-k * rotation_start_step
 // (a hand-held sweep that reverses leaves the constant-velocity rotation several degrees off, out
 // of NDT's basin), each first on a grid uncertain_ndt_scale times wider, then on the normal grid;
-// the start whose result scores best on the normal grid (by a margin) wins. A certain prior whose
-// solve took wide_start_iterations or more (slow: it may have stopped in a ripple of the grid, as
-// when a car enters a turn) gets the prior itself as the one other start.
+// the start whose result scores best on the normal grid (by a margin) wins. With
+// start_screen_points set and more starts than start_full_solves, the starts are first solved on a
+// spread subset of about start_screen_points points and ranked by their score there; only the best
+// few that beat the plain result on the subset are solved again on every point (most frames: none).
+// A certain prior whose solve took wide_start_iterations or more (slow: it may have stopped in a
+// ripple of the grid, as when a car enters a turn) gets the prior itself as the one other start.
 
 #include <cstddef>
 #include <optional>
@@ -26,7 +29,8 @@ namespace scanmatch {
 struct CoarseResult {
   Pose motion = Pose::Identity();  ///< from the reference frame (the prior when not registered)
   bool registered = false;         ///< enough points found a voxel; false: motion is the prior
-  int iterations = 0;              ///< every start's iterations
+  int iterations = 0;              ///< every start's iterations on every coarse point
+  int screen_iterations = 0;       ///< the starts' iterations on the ranking subset
   /// Another start beat the prior's own result: the prior was wrong and the frame recovered.
   bool recovered = false;
   double condition_number = 0.0;  ///< of the plain start's information matrix
@@ -48,9 +52,18 @@ class CoarseNdt {
   /// The best motion among `plain` and the other starts (adds their iterations; `recovered`
   /// when another start won).
   Pose best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                  bool uncertain, int& iterations, bool& recovered) const;
+                  bool uncertain, int& iterations, int& screen_iterations, bool& recovered) const;
   /// The starts to try, `prior_motion` first: only it for a certain prior.
   std::vector<Pose> other_starts(const Pose& prior_motion, bool uncertain) const;
+  /// Whether `start_count` starts on `source_points` points are ranked on a subset first.
+  bool should_screen(std::size_t start_count, std::size_t source_points) const;
+  /// Solves each start (wider grid, then normal grid) on about start_screen_points of `source`
+  /// and returns the start_full_solves best results that score better than `plain` there (none:
+  /// the plain result stands). Sets `from_wide_grid` false: they need only the normal grid on
+  /// every point.
+  std::vector<Pose> screened_starts(const PointCloud& source, const std::vector<Pose>& starts,
+                                    const Pose& plain, int& screen_iterations,
+                                    bool& from_wide_grid) const;
 
   OdometryConfig config_;
   SolverOptions solver_;

@@ -178,6 +178,13 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("wide_start_iterations", c.wide_start_iterations, nullptr,
     "ctf-icp: a certain prior whose NDT solve took this many iterations also starts on the wider "
     "grid (uncertain_ndt_scale), kept when it scores better (0: never)");
+  v("start_screen_points", c.start_screen_points, nullptr,
+    "ctf-icp, uncertain prior: the other starts are first solved and ranked on about this many "
+    "coarse points (0: every start solved on every point; 150 is 2-5x cheaper on recorded "
+    "keyframes, see docs/benchmarks.md)");
+  v("start_full_solves", c.start_full_solves, nullptr,
+    "ctf-icp: only this many best-ranked starts that beat the prior's result on that subset are "
+    "then solved on every point");
   v("uncertain_jump_scale", c.uncertain_jump_scale, nullptr,
     "max_jump and max_jump_angle widen by this factor under an uncertain prior");
   v("min_downsampled_points", c.min_downsampled_points, nullptr,

@@ -115,6 +115,15 @@ struct OdometryConfig {
   /// about a cell: on ground seen from low down the score ripples with the cells, and a prior
   /// 0.5 m or a few degrees off (a car entering a turn) stops in a ripple, slowly.
   int wide_start_iterations = 15;
+  /// ctf-icp, uncertain prior: the other starts are first solved and ranked on every n-th coarse
+  /// point, about this many, and only the best start_full_solves that beat the plain result there
+  /// are solved on every point (0: every start solved on every point). Off by default: 150 makes
+  /// the coarse stage 2-5x cheaper on avia_hku1 and riverside02_keyframes at the same or better
+  /// ATE, but sim:handheld-fast's ATE is 30 % worse over six seeds (docs/benchmarks.md, "Speed on
+  /// recorded frames").
+  std::uint32_t start_screen_points = 0;
+  /// ... and only this many best-ranked starts are then solved on every point.
+  int start_full_solves = 1;
   double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
