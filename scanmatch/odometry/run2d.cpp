@@ -131,8 +131,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   OccupancyGrid grid(options.grid), reference_grid(options.grid);
   TrajectoryWriter poses(file("poses_tum.txt"), TrajectoryFormat::kTum);
   LineWriter timing(file("timing.csv"));
-  timing.line(
-      "scan,ms,iterations,points,pairs,error_m,bridged,open_step_from_prior,fit,weak_fit");
+  timing.line("scan,ms,iterations,points,pairs,error_m,bridged,open_step_from_prior,fit,weak_fit");
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
@@ -174,9 +173,9 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     reference.push_back(pose2(laser.pose));
     poses.write(to_pose3(pose), laser.timestamp);
     char row[512];
-    std::snprintf(row, sizeof row, "%zu,%.4f,%d,%zu,%zu,%.6f,%d,%d,%.3f,%d", i, s.ms,
-                  s.iterations, s.points, s.pairs, s.error, s.bridged ? 1 : 0,
-                  s.open_step_from_prior ? 1 : 0, s.fit, s.weak_fit ? 1 : 0);
+    std::snprintf(row, sizeof row, "%zu,%.4f,%d,%zu,%zu,%.6f,%d,%d,%.3f,%d", i, s.ms, s.iterations,
+                  s.points, s.pairs, s.error, s.bridged ? 1 : 0, s.open_step_from_prior ? 1 : 0,
+                  s.fit, s.weak_fit ? 1 : 0);
     timing.line(row);
     // A trajectory that ran away (a failed method on hard data) can need more cells than the
     // grid allows: the run goes on and keeps its poses, without that map.
