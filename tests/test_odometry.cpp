@@ -62,8 +62,7 @@ OdometryRun run(const OdometryConfig& config, const Sequence& s, std::size_t fra
     r.bridged_frames += odometry.last_stats().bridged;
   }
   // The first frames as the runner writes them: settled once the world anchor is.
-  for (std::size_t i = 0; i < std::min(n, odometry.pipeline().world_settles_after()); ++i)
-    r.poses[i] = odometry.pipeline().settled_pose(i);
+  settle_early_poses(odometry.pipeline(), r.poses);
   r.ate = compute_ate({s.truth.begin(), s.truth.begin() + static_cast<std::ptrdiff_t>(n)}, r.poses);
   return r;
 }

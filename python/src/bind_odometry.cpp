@@ -2,7 +2,6 @@
 
 #include <pybind11/stl.h>
 
-#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -49,9 +48,7 @@ class PyOdometry {
     }
     poses_.push_back(pose);
     // The first frames were returned in a provisional world; poses holds them as settled since.
-    const OdometryPipeline& pipeline = odometry_.pipeline();
-    for (std::size_t i = 0; i < std::min(poses_.size(), pipeline.world_settles_after()); ++i)
-      poses_[i] = pipeline.settled_pose(i);
+    settle_early_poses(odometry_.pipeline(), poses_);
     timestamps_.push_back(stamp);
     stats_.push_back(odometry_.last_stats());
     return pose_to_array(pose);

@@ -1,5 +1,6 @@
 #include "scanmatch/odometry/frame_odometry.hpp"
 
+#include <algorithm>
 #include <map>
 
 #include "scanmatch/core/error.hpp"
@@ -34,6 +35,11 @@ constexpr KnownPeer kKnownPeers[] = {
 };
 
 }  // namespace
+
+void settle_early_poses(const FrameOdometry& odometry, std::vector<Pose>& poses) {
+  for (std::size_t i = 0; i < std::min(poses.size(), odometry.world_settles_after()); ++i)
+    poses[i] = odometry.settled_pose(i);
+}
 
 bool register_odometry_peer(const std::string& name, const std::string& description,
                             PeerFactory factory) {

@@ -47,6 +47,12 @@ class FrameOdometry {
   virtual const PointCloud* settled_first_frame() const { return nullptr; }
 };
 
+/// Replaces the poses of the frames before `odometry`'s world settles (poses[i]: frame i as
+/// register_frame returned it) with their poses in the world as it stands (settled once
+/// world_settles_after() frames are registered); the runner, Python's Odometry and the tests
+/// report frames through it.
+void settle_early_poses(const FrameOdometry& odometry, std::vector<Pose>& poses);
+
 /// Builds a peer from the run's configuration (the peer reads what applies to it: voxel_size,
 /// ranges, threads).
 using PeerFactory = std::function<std::unique_ptr<FrameOdometry>(const OdometryConfig&)>;

@@ -37,7 +37,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   const Stopwatch total;
   stats_ = FrameStats{};
   stats_.points_in = frame.size();
-  if (frames_ >= kWorldSettlesAfter) settled_first_frame_ = PointCloud{};
+  if (frames_ == kWorldSettlesAfter) settled_first_frame_ = PointCloud{};  // handed out by now
   if (frames_ == 0) {
     timed_frames_ = frame.has_time();
     first_sweep_ = latest_point_time(frame);
@@ -104,8 +104,6 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
     // at all (a still start's noise or a robot's jitter would turn every later pose).
     if (frames_ == 1) {
       first_velocity_ = se3_log(velocity);
-      anchor_rotation_ = first_velocity_.head<3>().norm() >= config_.anchor_min_rotation;
-      anchor_translation_ = first_velocity_.tail<3>().norm() >= config_.anchor_min_translation;
       world_from_internal_ = se3_exp(0.5 * anchored_part(first_velocity_));
     }
     if (frames_ == 2 && deskews_again_ && !stats_.bridged &&
@@ -179,8 +177,10 @@ PointCloud OdometryPipeline::frame_detail(const PointCloud& frame,
 
 Vector6d OdometryPipeline::anchored_part(const Vector6d& motion) const {
   Vector6d part = Vector6d::Zero();
-  if (anchor_rotation_) part.head<3>() = motion.head<3>();
-  if (anchor_translation_) part.tail<3>() = motion.tail<3>();
+  if (first_velocity_.head<3>().norm() >= config_.anchor_min_rotation)
+    part.head<3>() = motion.head<3>();
+  if (first_velocity_.tail<3>().norm() >= config_.anchor_min_translation)
+    part.tail<3>() = motion.tail<3>();
   return part;
 }
 

@@ -81,7 +81,8 @@ class OdometryPipeline : public FrameOdometry {
 
   static constexpr std::size_t kWorldSettlesAfter = 3;
 
-  /// The parts of a motion (log) that anchor the world: those above anchor_min_* at frame 1.
+  /// The parts of a motion (log) that anchor the world: those of the first measured motion above
+  /// anchor_min_*.
   Vector6d anchored_part(const Vector6d& motion) const;
   /// `frame` cropped, deskewed by `motion` (when given) and filtered at map density.
   PointCloud frame_detail(const PointCloud& frame, const FrameMotion* motion) const;
@@ -96,9 +97,8 @@ class OdometryPipeline : public FrameOdometry {
   bool wants_map_points_;
   bool deskews_again_;
   PointCloud map_points_;  ///< the last frame at map density (reused between frames)
-  Vector6d first_velocity_ = Vector6d::Zero();                 ///< log of the first measured motion
-  bool anchor_rotation_ = false, anchor_translation_ = false;  ///< see anchored_part
-  double first_sweep_ = 0.0;                                   ///< s: frame 0's latest point time
+  Vector6d first_velocity_ = Vector6d::Zero();  ///< log of the first measured motion
+  double first_sweep_ = 0.0;                    ///< s: frame 0's latest point time
   PointCloud first_frame_;  ///< frame 0 as given, until frame 1 has deskewed it (redeskew_*)
   PointCloud settled_first_frame_;  ///< frame 0 deskewed at frame 1, until the world settles
   /// Frame-start poses of the frames before the world settles, in the internal frame.

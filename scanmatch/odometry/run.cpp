@@ -289,11 +289,12 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   };
   // The frames before the world settles were returned in a provisional world: once it settles
   // (or the run ends first) they take their settled poses, and only then are they written.
-  std::size_t settled_poses = 0, written_poses = 0;
-  const auto settle_early_poses = [&] {
-    for (; settled_poses < summary.poses.size(); ++settled_poses)
-      if (settled_poses < odometry->world_settles_after())
-        summary.poses[settled_poses] = odometry->settled_pose(settled_poses);
+  bool poses_settled = false;
+  std::size_t written_poses = 0;
+  const auto settle_poses = [&] {
+    if (poses_settled) return;
+    settle_early_poses(*odometry, summary.poses);
+    poses_settled = true;
   };
   const auto write_poses_until = [&](std::size_t end) {
     for (; written_poses < end; ++written_poses) {
@@ -334,7 +335,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     summary.timestamps.push_back(frame.timestamp);
     summary.stats.push_back(s);
     const bool settled = summary.frames + 1 >= odometry->world_settles_after();
-    if (settled) settle_early_poses();
+    if (settled) settle_poses();
     if (write) {
       if (settled) write_poses_until(summary.frames + 1);
       timing->line(timing_csv_row(summary.frames, frame.timestamp, s));
@@ -359,7 +360,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     progress.update(summary.frames);
   }
   progress.finish();
-  settle_early_poses();  // a run shorter than the settling
+  settle_poses();  // a run shorter than the settling
   if (write) write_poses_until(summary.poses.size());
   hand_out_unsettled();
   if (loop_closure) {
