@@ -1,13 +1,11 @@
 #include "scanmatch/features/fpfh.hpp"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/core/parallel.hpp"
 #include "scanmatch/geometry/covariance.hpp"
 
 namespace scanmatch {
@@ -15,21 +13,6 @@ namespace {
 
 constexpr int kBinsPerAngle = kFpfhBins / 3;
 constexpr std::size_t kMaxNeighbours = 128;
-
-template <typename Body>
-void for_each_index(std::size_t n, int num_threads, Body body) {
-  if (num_threads <= 1) {
-    for (std::size_t i = 0; i < n; ++i) body(i);
-    return;
-  }
-  tbb::task_arena arena(num_threads);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t i = r.begin(); i < r.end(); ++i) body(i);
-                      });
-  });
-}
 
 int bin_of(double value, double low, double high) {
   const int b = static_cast<int>(std::floor((value - low) / (high - low) * kBinsPerAngle));
@@ -118,7 +101,7 @@ std::vector<FpfhDescriptor> compute_fpfh(const PointCloud& cloud, const KdTree& 
   // searched once (a keypoint's serves both its SPFH and its FPFH).
   std::vector<std::vector<Neighbour>> neighbours(cloud.size());
   std::vector<char> searched(cloud.size(), 0);
-  for_each_index(keypoints.size(), options.num_threads, [&](std::size_t k) {
+  for_each_index(keypoints.size(), options.num_threads, 64, [&](std::size_t k) {
     neighbours[keypoints[k]] = neighbours_within(cloud, tree, keypoints[k], options);
   });
   for (std::size_t k : keypoints) searched[k] = 1;
@@ -132,11 +115,11 @@ std::vector<FpfhDescriptor> compute_fpfh(const PointCloud& cloud, const KdTree& 
     if (needed[i]) needed_points.push_back(i);
     if (needed[i] && !searched[i]) unsearched.push_back(i);
   }
-  for_each_index(unsearched.size(), options.num_threads, [&](std::size_t j) {
+  for_each_index(unsearched.size(), options.num_threads, 64, [&](std::size_t j) {
     neighbours[unsearched[j]] = neighbours_within(cloud, tree, unsearched[j], options);
   });
   std::vector<FpfhDescriptor> spfh(cloud.size(), FpfhDescriptor::Zero());
-  for_each_index(needed_points.size(), options.num_threads, [&](std::size_t j) {
+  for_each_index(needed_points.size(), options.num_threads, 64, [&](std::size_t j) {
     const std::size_t i = needed_points[j];
     const Eigen::Vector3d p = cloud.points[i].cast<double>();
     FpfhDescriptor h = FpfhDescriptor::Zero();
@@ -154,7 +137,7 @@ std::vector<FpfhDescriptor> compute_fpfh(const PointCloud& cloud, const KdTree& 
   });
 
   std::vector<FpfhDescriptor> out(keypoints.size(), FpfhDescriptor::Zero());
-  for_each_index(keypoints.size(), options.num_threads, [&](std::size_t k) {
+  for_each_index(keypoints.size(), options.num_threads, 64, [&](std::size_t k) {
     const auto& nbs = neighbours[keypoints[k]];
     if (nbs.size() < 3) return;
     FpfhDescriptor neighbours = FpfhDescriptor::Zero();

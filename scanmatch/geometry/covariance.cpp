@@ -1,9 +1,8 @@
 #include "scanmatch/geometry/covariance.hpp"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <Eigen/Eigenvalues>
+
+#include "scanmatch/core/parallel.hpp"
 
 namespace scanmatch {
 
@@ -19,20 +18,6 @@ Eigen::Vector3d smallest_eigenvector(const Eigen::Matrix3d& C) {
 }
 
 namespace {
-template <typename Body>
-void for_each_point(std::size_t n, int num_threads, Body body) {
-  if (num_threads <= 1) {
-    for (std::size_t i = 0; i < n; ++i) body(i);
-    return;
-  }
-  tbb::task_arena arena(num_threads);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t i = r.begin(); i < r.end(); ++i) body(i);
-                      });
-  });
-}
 
 Eigen::Matrix3d neighbourhood_covariance(const PointCloud& cloud, const KdTree& tree, std::size_t i,
                                          int k) {
@@ -56,7 +41,7 @@ Eigen::Matrix3d neighbourhood_covariance(const PointCloud& cloud, const KdTree& 
 std::vector<Eigen::Matrix3d> estimate_covariances(const PointCloud& cloud, const KdTree& tree,
                                                   int k, int num_threads) {
   std::vector<Eigen::Matrix3d> out(cloud.size());
-  for_each_point(cloud.size(), num_threads,
+  for_each_index(cloud.size(), num_threads, 256,
                  [&](std::size_t i) { out[i] = neighbourhood_covariance(cloud, tree, i, k); });
   return out;
 }
@@ -64,7 +49,7 @@ std::vector<Eigen::Matrix3d> estimate_covariances(const PointCloud& cloud, const
 std::vector<Eigen::Vector3d> estimate_normals(const PointCloud& cloud, const KdTree& tree, int k,
                                               int num_threads) {
   std::vector<Eigen::Vector3d> out(cloud.size());
-  for_each_point(cloud.size(), num_threads, [&](std::size_t i) {
+  for_each_index(cloud.size(), num_threads, 256, [&](std::size_t i) {
     out[i] = smallest_eigenvector(neighbourhood_covariance(cloud, tree, i, k));
   });
   return out;
