@@ -127,7 +127,8 @@ struct Pgm {
   std::vector<std::uint8_t> pixels;
 };
 
-Pgm read_pgm(const std::string& path) {
+// Parsed here, not by the library's read_pgm: the writer is checked by an independent reader.
+Pgm parse_pgm(const std::string& path) {
   const std::string bytes = read_bytes(path);
   Pgm pgm;
   std::istringstream header(bytes);
@@ -475,7 +476,7 @@ TEST(GridMap, MapServerFilesReadBack) {
   EXPECT_EQ(lines[6], "mode: trinary");
 
   // PGM: header, size, and every pixel against the grid (row 0 = highest y).
-  const Pgm pgm = read_pgm(dir.file("room.pgm"));
+  const Pgm pgm = parse_pgm(dir.file("room.pgm"));
   ASSERT_EQ(pgm.width, grid.width());
   ASSERT_EQ(pgm.height, grid.height());
   EXPECT_EQ(pgm.maxval, 255);

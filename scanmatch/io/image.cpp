@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <sstream>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/file_util.hpp"
@@ -167,6 +168,33 @@ Image8 read_png(const std::string& path) {
       out[k] = static_cast<std::uint8_t>(in[k + 1] + predictor);
     }
   }
+  return image;
+}
+
+Image8 read_pgm(const std::string& path) {
+  std::istringstream pgm(read_file_bytes(path));
+  const auto skip_comments = [&] {
+    while (pgm >> std::ws && pgm.peek() == '#') pgm.ignore(1 << 20, '\n');
+  };
+  std::string magic;
+  int maxval = 0;
+  Image8 image;
+  image.channels = 1;
+  pgm >> magic;
+  skip_comments();
+  pgm >> image.width;
+  skip_comments();
+  pgm >> image.height;
+  skip_comments();
+  pgm >> maxval;
+  if (magic != "P5" || !pgm || image.width <= 0 || image.height <= 0 || maxval != 255)
+    fail(path, "not an 8-bit binary PGM (P5, maxval 255)");
+  pgm.get();  // the one whitespace before the pixels
+  image.pixels.resize(static_cast<std::size_t>(image.width) * image.height);
+  if (!pgm.read(reinterpret_cast<char*>(image.pixels.data()),
+                static_cast<std::streamsize>(image.pixels.size())))
+    fail(path, "fewer pixels than its header's " + std::to_string(image.width) + " x " +
+                   std::to_string(image.height));
   return image;
 }
 

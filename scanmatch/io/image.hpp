@@ -1,6 +1,7 @@
 #pragma once
 // Writers for 8-bit images: binary PGM (P5) and PNG (grayscale or RGB), encoded here with zlib;
-// a reader for 8-bit PNG (e.g. a browser's screenshot, which tests inspect).
+// readers for binary PGM (a map2d run's map.pgm) and 8-bit PNG (e.g. a browser's screenshot,
+// which tests inspect).
 // Pixels are row-major with row 0 the top row of the image. Files are written atomically
 // (write_file_atomic), so a reader never sees a half-written image.
 
@@ -31,6 +32,10 @@ struct Image8 {
   int width = 0, height = 0, channels = 0;
   std::vector<std::uint8_t> pixels;
 };
+
+/// Reads a binary PGM (P5, maxval 255; comments allowed in the header) as one channel. Throws
+/// Error naming the file for anything else or fewer pixels than the header says.
+Image8 read_pgm(const std::string& path);
 
 /// Reads a non-interlaced 8-bit PNG of colour type 0, 2, 4 or 6 (any of the five row filters).
 /// Throws Error naming the file for anything else or a damaged file.

@@ -20,6 +20,7 @@
 #include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
+#include "scanmatch/io/image.hpp"
 #include "scanmatch/odometry/health.hpp"
 #include "scanmatch/odometry/report.hpp"
 
@@ -129,26 +130,8 @@ json encode_map(const PointCloud& cloud, const std::string& description,
 // to at most 4096 cells a side, the texture size every WebGL has.
 json encode_grid(const std::string& folder) {
   const std::string pgm_path = folder + "/map.pgm", yaml_path = folder + "/map.yaml";
-  std::istringstream pgm(read_file_bytes(pgm_path));
-  std::string magic;
-  int width = 0, height = 0, maxval = 0;
-  const auto skip_comments = [&] {
-    while (pgm >> std::ws && pgm.peek() == '#') pgm.ignore(1 << 20, '\n');
-  };
-  pgm >> magic;
-  skip_comments();
-  pgm >> width;
-  skip_comments();
-  pgm >> height;
-  skip_comments();
-  pgm >> maxval;
-  if (magic != "P5" || !pgm || width <= 0 || height <= 0 || maxval != 255)
-    fail(pgm_path, "not an 8-bit binary PGM (P5, maxval 255)");
-  pgm.get();  // the one whitespace before the pixels
-  std::string pixels(static_cast<std::size_t>(width) * height, '\0');
-  if (!pgm.read(pixels.data(), static_cast<std::streamsize>(pixels.size())))
-    fail(pgm_path, "fewer pixels than its header's " + std::to_string(width) + " x " +
-                       std::to_string(height));
+  const Image8 image = read_pgm(pgm_path);
+  const int width = image.width, height = image.height;
 
   double resolution = 0, origin_x = 0, origin_y = 0;
   bool has_resolution = false, has_origin = false;
@@ -170,7 +153,7 @@ json encode_grid(const std::string& folder) {
     for (int x = 0; x < width; ++x) {
       const int row = (height - 1 - y) / factor;  // image row 0 is the top, the highest y
       char& cell = levels[static_cast<std::size_t>(row) * cols + x / factor];
-      const char pixel = pixels[static_cast<std::size_t>(y) * width + x];
+      const char pixel = static_cast<char>(image.pixels[static_cast<std::size_t>(y) * width + x]);
       if (static_cast<unsigned char>(pixel) < static_cast<unsigned char>(cell)) cell = pixel;
     }
   return {{"width", cols},
