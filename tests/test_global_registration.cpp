@@ -131,14 +131,18 @@ TEST(Fpfh, DescriptorsDoNotChangeWithARigidMotionOfCloudAndViewpoint) {
   EXPECT_GT(described, keypoints.size() / 2);
 }
 
-TEST(GlobalRegistration, SimulatedCarFramesFromRandomYawsAndTenMetres) {
+// campus-os1 frames 45 onto 40: 0.5 s (3 m) apart, so the two clouds sample the scene differently.
+Pair campus_pair() {
   sim::SimOptions so;
   so.preset = "campus-os1";
   so.frames = 46;
   so.motion_distortion = false;
   const sim::Simulator s(so);
-  // Frames 0.5 s (3 m) apart, so the two clouds sample the scene differently.
-  const Pair pair{s.frame(45), s.frame(40), s.pose(40).inverse() * s.pose(45)};
+  return {s.frame(45), s.frame(40), s.pose(40).inverse() * s.pose(45)};
+}
+
+TEST(GlobalRegistration, SimulatedCarFramesFromRandomYawsAndTenMetres) {
+  const Pair pair = campus_pair();
   std::mt19937 rng(43);
   std::uniform_real_distribution<double> yaw(-180.0, 180.0), direction(-180.0, 180.0);
   const int trials = scanmatch::testing::sanitized() ? 1 : 3;
@@ -216,12 +220,8 @@ TEST(GlobalRegistration, FailsAndSaysSoOnAPlaneOrOnNoise) {
 // the target's viewpoint, the origin, halfway between them): two motions fit equally well, so
 // the answer must be "ambiguous", not one of them.
 TEST(GlobalRegistration, RefusesWhenTwoPlacesFitEqually) {
-  sim::SimOptions so;
-  so.preset = "campus-os1";
-  so.frames = 46;
-  so.motion_distortion = false;
-  const sim::Simulator s(so);
-  const PointCloud source = s.frame(45), place = s.frame(40);
+  const Pair pair = campus_pair();
+  const PointCloud &source = pair.source, &place = pair.target;
   PointCloud target;
   std::mt19937 rng(5);
   std::normal_distribution<float> jitter(0.0f, 0.02f);

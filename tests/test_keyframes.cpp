@@ -301,13 +301,21 @@ TEST(AdaptiveRules, ASparseFrameKeepsMorePointsADenseOneIsUnchanged) {
             voxel_downsample(dense, c.voxel_size).points);
 }
 
-TEST(AdaptiveRules, ATurnedStartRecoversAPriorThatMissedTheTurn) {
+namespace {
+
+// Two recorded Avia keyframes (12 and 13: the sensor turns 12.5 degrees and moves 0.13 m), their
+// reference motion (FAST-LIO2, good to centimetres) and a prior that missed the turn by 15
+// degrees, as when a hand-held sweep reverses. Empty frames without ../shared.
+struct MissedTurn {
+  PointCloud reference_frame, frame;
+  Pose truth = Pose::Identity();
+  MotionPrior prior;
+};
+
+MissedTurn avia_missed_turn() {
+  MissedTurn m;
   const std::string folder = scanmatch::testing::shared_data("data/3d/avia_hku1");
-  if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
-  // Two recorded Avia keyframes (12 and 13: the sensor turns 12.5 degrees and moves 0.13 m) and a
-  // prior that missed the turn by 15 degrees, as when a hand-held sweep reverses: the other
-  // starts (identity, half and twice the prior) end 8 degrees and 0.9 m off, the recording's
-  // failure; a turned start brings it back. The reference (FAST-LIO2) is good to centimetres.
+  if (folder.empty()) return m;
   const std::size_t a = 12, b = 13;
   const auto frame_at = [&](std::size_t i) {
     char name[32];
@@ -315,18 +323,30 @@ TEST(AdaptiveRules, ATurnedStartRecoversAPriorThatMissedTheTurn) {
     return voxel_downsample(read_cloud(folder + name), 0.25);
   };
   const Trajectory reference = read_trajectory(folder + "/odom_poses.txt");
-  const Pose truth = reference.poses[a].inverse() * reference.poses[b];
-  MotionPrior prior;
-  prior.uncertain = true;
-  prior.motion = truth;
-  prior.motion.linear() =
-      truth.linear() * Eigen::AngleAxisd(0.26, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  m.reference_frame = frame_at(a);
+  m.frame = frame_at(b);
+  m.truth = reference.poses[a].inverse() * reference.poses[b];
+  m.prior.uncertain = true;
+  m.prior.motion = m.truth;
+  m.prior.motion.linear() =
+      m.truth.linear() * Eigen::AngleAxisd(0.26, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return m;
+}
+
+}  // namespace
+
+TEST(AdaptiveRules, ATurnedStartRecoversAPriorThatMissedTheTurn) {
+  // The other starts (identity, half and twice the prior) end 8 degrees and 0.9 m off, the
+  // recording's failure; a turned start brings it back.
+  const MissedTurn m = avia_missed_turn();
+  if (m.frame.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
+  const Pose& truth = m.truth;
   const auto align = [&](int rotation_starts) {
     OdometryConfig c;
     c.rotation_starts = rotation_starts;
     CoarseNdt coarse(c);
-    coarse.set_reference(frame_at(a), false);
-    return coarse.align(frame_at(b), prior);
+    coarse.set_reference(m.reference_frame, false);
+    return coarse.align(m.frame, m.prior);
   };
   const auto error_deg = [&](const CoarseResult& r) {
     return rotation_angle(truth.inverse() * r.motion) * kDegreesPerRadian;
@@ -340,30 +360,18 @@ TEST(AdaptiveRules, ATurnedStartRecoversAPriorThatMissedTheTurn) {
 }
 
 TEST(AdaptiveRules, RankedStartsRecoverTheTurnWithFewerFullSolves) {
-  const std::string folder = scanmatch::testing::shared_data("data/3d/avia_hku1");
-  if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
-  // The keyframes and the prior 15 degrees off of the test above. Ranking the starts on a subset
-  // of the coarse points first (start_screen_points) must pick the turned start that solving
-  // every start on every point picks, at a fraction of the solves on every point.
-  const std::size_t a = 12, b = 13;
-  const auto frame_at = [&](std::size_t i) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "/frames/%06zu.pcd", i);
-    return voxel_downsample(read_cloud(folder + name), 0.25);
-  };
-  const Trajectory reference = read_trajectory(folder + "/odom_poses.txt");
-  const Pose truth = reference.poses[a].inverse() * reference.poses[b];
-  MotionPrior prior;
-  prior.uncertain = true;
-  prior.motion = truth;
-  prior.motion.linear() =
-      truth.linear() * Eigen::AngleAxisd(0.26, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  // Ranking the starts on a subset of the coarse points first (start_screen_points) must pick the
+  // turned start that solving every start on every point picks, at a fraction of the solves on
+  // every point.
+  const MissedTurn m = avia_missed_turn();
+  if (m.frame.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
+  const Pose& truth = m.truth;
   const auto align = [&](std::uint32_t screen_points) {
     OdometryConfig c;
     c.start_screen_points = screen_points;
     CoarseNdt coarse(c);
-    coarse.set_reference(frame_at(a), false);
-    return coarse.align(frame_at(b), prior);
+    coarse.set_reference(m.reference_frame, false);
+    return coarse.align(m.frame, m.prior);
   };
   const CoarseResult ranked = align(150);
   const CoarseResult every = align(0);
