@@ -7,9 +7,9 @@
 #include "apps/config_options.hpp"
 #include "apps/interrupt.hpp"
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/odometry/config_io.hpp"
-#include "scanmatch/odometry/run2d.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
+#include "scanmatch/run/map2d_run.hpp"
+#include "scanmatch/run/run_config.hpp"
 
 namespace scanmatch::cli {
 namespace {

@@ -6,9 +6,9 @@
 #include "apps/commands.hpp"
 #include "apps/config_options.hpp"
 #include "apps/interrupt.hpp"
-#include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
-#include "scanmatch/odometry/run.hpp"
+#include "scanmatch/run/odometry_run.hpp"
+#include "scanmatch/run/run_config.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch::cli {

@@ -4,7 +4,7 @@
 #include "apps/commands.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/file_util.hpp"
-#include "scanmatch/odometry/report.hpp"
+#include "scanmatch/run/report.hpp"
 
 namespace scanmatch::cli {
 

@@ -1,13 +1,13 @@
 #pragma once
-// Command-line options from the configuration's one description (odometry/config_fields.hpp):
-// every described field with a flag becomes an option bound to that field (a bool's "--no-" flag
-// sets it to false).
+// Command-line options from the configuration's one description (config/fields.hpp and each
+// module's config/*_fields.hpp): every described field with a flag becomes an option bound to that
+// field (a bool's "--no-" flag sets it to false).
 
 #include <CLI/CLI.hpp>
 #include <string_view>
 #include <type_traits>
 
-#include "scanmatch/odometry/config_fields.hpp"
+#include "scanmatch/run/run_config_fields.hpp"
 
 namespace scanmatch::cli {
 

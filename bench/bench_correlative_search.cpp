@@ -6,8 +6,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "scanmatch/odometry/run2d.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
+#include "scanmatch/run/map2d_run.hpp"
 
 namespace {
 using namespace scanmatch;

@@ -6,10 +6,11 @@
 #include <filesystem>
 #include <set>
 
+#include "scanmatch/config/config_io.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/file_util.hpp"
-#include "scanmatch/odometry/config_fields.hpp"
-#include "scanmatch/odometry/config_io.hpp"
+#include "scanmatch/run/run_config.hpp"
+#include "scanmatch/run/run_config_fields.hpp"
 #include "test_helpers.hpp"
 
 namespace scanmatch {

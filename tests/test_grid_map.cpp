@@ -17,7 +17,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/image.hpp"
-#include "scanmatch/odometry/grid_map.hpp"
+#include "scanmatch/mapping2d/grid_map.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;

@@ -13,8 +13,8 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics2d.hpp"
 #include "scanmatch/mapping/loop_closure2d.hpp"
-#include "scanmatch/odometry/mapper2d.hpp"
-#include "scanmatch/odometry/run2d.hpp"
+#include "scanmatch/mapping2d/mapper2d.hpp"
+#include "scanmatch/run/map2d_run.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
 

@@ -13,10 +13,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scanmatch/config/config_io.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/trajectory.hpp"
-#include "scanmatch/odometry/config_io.hpp"
+#include "scanmatch/run/run_config.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;

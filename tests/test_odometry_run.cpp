@@ -8,7 +8,7 @@
 
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/io/trajectory.hpp"
-#include "scanmatch/odometry/run.hpp"
+#include "scanmatch/run/odometry_run.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
 #include "test_helpers.hpp"
 

@@ -11,7 +11,7 @@
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/eval/table.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
-#include "scanmatch/odometry/report.hpp"
+#include "scanmatch/run/report.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;

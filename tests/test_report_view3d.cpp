@@ -1,4 +1,4 @@
-// The report's 3D view (scanmatch/odometry/report_view3d.hpp): the point budget, the map rebuilt
+// The report's 3D view (scanmatch/run/report_view3d.hpp): the point budget, the map rebuilt
 // from frames, and the page in headless Chromium with WebGL in software (SwiftShader) when
 // Chromium is installed: what the scene holds, that it draws, and the page without three.js.
 #include <gtest/gtest.h>
@@ -11,8 +11,8 @@
 #include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/image.hpp"
-#include "scanmatch/odometry/report.hpp"
-#include "scanmatch/odometry/report_view3d.hpp"
+#include "scanmatch/run/report.hpp"
+#include "scanmatch/run/report_view3d.hpp"
 #include "test_helpers.hpp"
 
 using namespace scanmatch;

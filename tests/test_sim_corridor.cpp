@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/odometry/run2d.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
+#include "scanmatch/run/map2d_run.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "scanmatch/sim/worlds.hpp"
 

@@ -9,8 +9,8 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/odometry/odometry_config.hpp"
-#include "scanmatch/odometry/run.hpp"
 #include "scanmatch/odometry/spin_times.hpp"
+#include "scanmatch/run/odometry_run.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"

@@ -1,4 +1,4 @@
-// 2D scan matching: register2d (registration/scan2d.hpp) and Mapper2D (odometry/mapper2d.hpp).
+// 2D scan matching: register2d (registration/scan2d.hpp) and Mapper2D (mapping2d/mapper2d.hpp).
 // Scans are (N, 2) arrays of x y in the laser frame, in beam order (copied once into the
 // library's Scan2D); poses are 3x3 homogeneous float64 matrices (copies).
 
@@ -11,10 +11,10 @@
 #include "options.hpp"
 #include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/io/carmen.hpp"
-#include "scanmatch/odometry/config_fields.hpp"
-#include "scanmatch/odometry/mapper2d.hpp"
+#include "scanmatch/mapping2d/mapper2d.hpp"
 #include "scanmatch/registration/planar/correspondence_path.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
+#include "scanmatch/run/run_config_fields.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 namespace scanmatch::python {

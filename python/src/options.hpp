@@ -1,6 +1,6 @@
 #pragma once
 // Keyword arguments onto an options struct, generically, from the one description of its fields
-// (scanmatch/odometry/config_fields.hpp's describe()): every described field is a keyword, by its
+// (scanmatch/run/run_config_fields.hpp's describe()): every described field is a keyword, by its
 // JSON key. Nested objects (e.g. "solver", "registration") take either a dict
 // (solver={"max_iterations": 5}) or their fields directly (max_iterations=5) when that key is
 // unique in the whole description; the dotted form ("solver.max_iterations") always works.
@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/odometry/config_fields.hpp"
+#include "scanmatch/run/run_config_fields.hpp"
 
 namespace scanmatch::python {
 
@@ -83,7 +83,7 @@ class FieldTable {
   void assign(const std::string& path, unsigned long& field, py::handle value) const;
   void assign(const std::string& path, bool& field, py::handle value) const;
   void assign(const std::string& path, std::string& field, py::handle value) const;
-  /// Enumerations by name (enum_name / enum_from_name of config_fields.hpp).
+  /// Enumerations by name (enum_name / enum_from_name of config/*_fields.hpp).
   template <typename E, typename = std::enable_if_t<std::is_enum_v<E>>>
   void assign(const std::string& path, E& field, py::handle value) const {
     if (!py::isinstance<py::str>(value)) wrong_type(path, "a name", value);

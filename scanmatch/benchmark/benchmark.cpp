@@ -15,8 +15,8 @@
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/preprocessor.hpp"
-#include "scanmatch/odometry/report.hpp"
 #include "scanmatch/registration/methods.hpp"
+#include "scanmatch/run/report.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
 #include "scanmatch/sim/simulator.hpp"
 

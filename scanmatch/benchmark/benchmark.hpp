@@ -4,7 +4,7 @@
 // times, ablation, static drift, KITTI drift, the LOAM paper's accuracy score and ms per frame).
 // Writes under OUT:
 //   data/PRESET/            simulated data sets, kept and reused by later runs (see --data)
-//   runs/SEQUENCE/VARIANT/  one run folder per variant (scanmatch/odometry/run.hpp)
+//   runs/SEQUENCE/VARIANT/  one run folder per variant (scanmatch/run/odometry_run.hpp)
 //   tables.md, tables.csv   the tables; report.html (tables and the first sequence's plots) and
 //                           report_SEQUENCE.html per sequence
 
@@ -14,7 +14,7 @@
 
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/eval/table.hpp"
-#include "scanmatch/odometry/run.hpp"
+#include "scanmatch/run/odometry_run.hpp"
 
 namespace scanmatch {
 

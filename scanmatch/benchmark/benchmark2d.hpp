@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "scanmatch/odometry/mapper2d.hpp"
+#include "scanmatch/mapping2d/mapper2d.hpp"
 
 namespace scanmatch {
 

@@ -4,7 +4,7 @@
 // registration method frame-to-frame (FrameToFrameOdometry), as in the papers' comparisons.
 //
 // Where each part lives (odometry/):
-//   odometry_config.hpp        every parameter (described once in config_fields.hpp)
+//   odometry_config.hpp        every parameter (described once in config/odometry_fields.hpp)
 //   odometry_pipeline.hpp      the frame loop both pipelines share
 //   preprocessor.hpp           range crop, deskew, adaptive voxel filter
 //   motion_model.hpp           the motion prior, its uncertainty, the gate

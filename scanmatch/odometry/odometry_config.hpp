@@ -1,6 +1,6 @@
 #pragma once
 // The configuration of the 3D odometry (every pipeline and stage reads its part of it). Each field
-// is described once, with its JSON key and flag, in config_fields.hpp.
+// is described once, with its JSON key and flag, in config/odometry_fields.hpp.
 
 #include <cmath>
 #include <cstdint>

@@ -24,4 +24,10 @@ struct RegistrationOptions {
   SolverOptions solver;
 };
 
+/// `register`'s configuration: both clouds are voxel-downsampled, then registered.
+struct PairRegistrationOptions {
+  double voxel_size = 0.1;  ///< m; 0: no downsampling
+  RegistrationOptions registration;
+};
+
 }  // namespace scanmatch

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "scanmatch/odometry/run.hpp"
+#include "scanmatch/run/odometry_run.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch::testing {

@@ -8,7 +8,7 @@
 
 #include "peer_run.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
-#include "scanmatch/odometry/run.hpp"
+#include "scanmatch/run/odometry_run.hpp"
 #include "scanmatch/sim/simulator.hpp"
 
 using namespace scanmatch;

@@ -1,15 +1,18 @@
-#include "scanmatch/odometry/config_io.hpp"
+#pragma once
+// Reading and writing any described configuration (config/fields.hpp) as JSON: keys are the field
+// names, nested options nested objects; a file may give any subset; unknown keys and wrong types
+// are errors naming the file and the key. For the .cpp files that define a module's or a run's
+// config I/O (config_io.cpp, run/run_config.cpp); it pulls in nlohmann/json.
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string>
 #include <type_traits>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/io/file_util.hpp"
-#include "scanmatch/odometry/config_fields.hpp"
 
-namespace scanmatch {
-namespace {
+namespace scanmatch::config_json {
 
 using Json = nlohmann::ordered_json;
 
@@ -109,7 +112,7 @@ struct FromJson {
   }
 };
 
-Json parse(const std::string& text, const std::string& source) {
+inline Json parse(const std::string& text, const std::string& source) {
   try {
     return Json::parse(text);
   } catch (const Json::parse_error& e) {
@@ -145,53 +148,4 @@ Config config_override_given(const Config& base, const Config& given,
   return c;
 }
 
-}  // namespace
-
-std::string odometry_config_to_json(const OdometryConfig& config) {
-  return config_to_json(config);
-}
-
-OdometryConfig odometry_config_from_json(const std::string& text, const std::string& source,
-                                         const OdometryConfig& base) {
-  return config_from_json(text, source, base);
-}
-
-OdometryConfig read_odometry_config(const std::string& path, const OdometryConfig& base) {
-  OdometryRunConfig run_base;
-  run_base.odometry = base;
-  return read_odometry_run_config(path, run_base).odometry;
-}
-
-OdometryConfig override_given_flags(const OdometryConfig& base, const OdometryConfig& given,
-                                    const std::function<bool(const std::string&)>& was_given) {
-  return config_override_given(base, given, was_given);
-}
-
-std::string odometry_run_config_to_json(const OdometryRunConfig& config) {
-  return config_to_json(config);
-}
-
-OdometryRunConfig read_odometry_run_config(const std::string& path, const OdometryRunConfig& base) {
-  return config_from_json(read_file_bytes(path), path, base);
-}
-
-OdometryRunConfig override_given_flags(const OdometryRunConfig& base,
-                                       const OdometryRunConfig& given,
-                                       const std::function<bool(const std::string&)>& was_given) {
-  return config_override_given(base, given, was_given);
-}
-
-std::string map2d_config_to_json(const Map2DRunOptions& options) {
-  return config_to_json(options);
-}
-
-Map2DRunOptions read_map2d_config(const std::string& path, const Map2DRunOptions& base) {
-  return config_from_json(read_file_bytes(path), path, base);
-}
-
-Map2DRunOptions override_given_flags(const Map2DRunOptions& base, const Map2DRunOptions& given,
-                                     const std::function<bool(const std::string&)>& was_given) {
-  return config_override_given(base, given, was_given);
-}
-
-}  // namespace scanmatch
+}  // namespace scanmatch::config_json

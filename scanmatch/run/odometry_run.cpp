@@ -1,4 +1,4 @@
-#include "scanmatch/odometry/run.hpp"
+#include "scanmatch/run/odometry_run.hpp"
 
 #include <algorithm>
 #include <array>
@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "scanmatch/config/config_io.hpp"
 #include "scanmatch/core/background_worker.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
@@ -19,10 +20,10 @@
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/trajectory.hpp"
-#include "scanmatch/odometry/config_io.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/health.hpp"
 #include "scanmatch/odometry/spin_times.hpp"
+#include "scanmatch/run/run_config.hpp"
 
 namespace scanmatch {
 namespace {

@@ -1,4 +1,4 @@
-#include "scanmatch/odometry/report.hpp"
+#include "scanmatch/run/report.hpp"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include "scanmatch/eval/svg_plot.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/odometry/health.hpp"
-#include "scanmatch/odometry/report_view3d.hpp"
+#include "scanmatch/run/report_view3d.hpp"
 
 namespace scanmatch {
 namespace {

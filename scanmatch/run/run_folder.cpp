@@ -1,4 +1,4 @@
-#include "scanmatch/odometry/run_folder.hpp"
+#include "scanmatch/run/run_folder.hpp"
 
 #include <filesystem>
 #include <fstream>

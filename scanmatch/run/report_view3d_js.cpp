@@ -2,7 +2,7 @@
 // scene and its controls, and writes what it drew to #view3d-status. Plain ES5 over three.js
 // r111 (Debian's libjs-three) and its OrbitControls, both inlined before it.
 
-#include "scanmatch/odometry/report_view3d.hpp"
+#include "scanmatch/run/report_view3d.hpp"
 
 namespace scanmatch {
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "scanmatch/core/point_cloud.hpp"
-#include "scanmatch/odometry/run_folder.hpp"
+#include "scanmatch/run/run_folder.hpp"
 #include "scanmatch/sim/open_sequence.hpp"
 
 namespace scanmatch {

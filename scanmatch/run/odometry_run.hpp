@@ -14,7 +14,7 @@
 //                   when the source has ground truth (written atomically at the end, also after
 //                   such an error)
 //   config.json     the OdometryConfig used and the map export options (reloadable with
-//                   --config; scanmatch/odometry/config_io.hpp)
+//                   --config; scanmatch/run/run_config.hpp)
 //   map.pcd/.ply    on request: the accumulated registered frames, voxel-downsampled
 // With loop closure (RunOptions::loop_closure; mapping/loop_closure3d.hpp) also, at the end:
 //   poses_optimized.txt, poses_optimized_tum.txt   the loop-closed poses (KITTI, TUM rows)

@@ -1,4 +1,4 @@
-#include "scanmatch/odometry/mapper2d.hpp"
+#include "scanmatch/mapping2d/mapper2d.hpp"
 
 #include <algorithm>
 

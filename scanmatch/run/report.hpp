@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "scanmatch/odometry/report_view3d.hpp"
-#include "scanmatch/odometry/run_folder.hpp"
+#include "scanmatch/run/report_view3d.hpp"
+#include "scanmatch/run/run_folder.hpp"
 
 namespace scanmatch {
 

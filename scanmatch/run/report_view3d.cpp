@@ -1,4 +1,4 @@
-#include "scanmatch/odometry/report_view3d.hpp"
+#include "scanmatch/run/report_view3d.hpp"
 
 #include <fmt/format.h>
 
@@ -22,7 +22,7 @@
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/image.hpp"
 #include "scanmatch/odometry/health.hpp"
-#include "scanmatch/odometry/report.hpp"
+#include "scanmatch/run/report.hpp"
 
 namespace scanmatch {
 namespace {

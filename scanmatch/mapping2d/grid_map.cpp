@@ -1,4 +1,4 @@
-#include "scanmatch/odometry/grid_map.hpp"
+#include "scanmatch/mapping2d/grid_map.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -9,7 +9,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/image.hpp"
-#include "scanmatch/odometry/grid_map.hpp"
+#include "scanmatch/mapping2d/grid_map.hpp"
 
 namespace scanmatch {
 namespace {
