@@ -29,7 +29,6 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
     given = override_given_flags(read_odometry_run_config(c.config_file), c.config,
                                  [&](const std::string& flag) { return cmd.count(flag) > 0; });
   OdometryConfig& config = given.odometry;
-  config.registration.solver.num_threads = config.threads;
 
   SequenceOptions input;
   input.topic = c.topic;

@@ -95,14 +95,13 @@ Odometry(method="ctf-icp", **config): LiDAR odometry frame by frame.
 method is ctf-icp or any registration method (frame to frame). config keywords are the fields
 of OdometryConfig by their JSON keys (odometry_options() lists them with their defaults), e.g.
 voxel_size=0.5, map_radius=30, deskew=False, threads=2, max_iterations=20,
-registration={"voxel_resolution": 0.5}. threads also sets the solver's threads, as the CLI does.
+registration={"voxel_resolution": 0.5}. threads sets every stage's threads.
 Unknown keys and wrong types raise TypeError; invalid values scanmatch.Error.)doc")
       .def(py::init([](const std::string& method, py::kwargs kwargs) {
              OdometryConfig config;
              config.method = method;
              FieldTable table(config, "Odometry()");
              table.apply(kwargs);
-             config.registration.solver.num_threads = config.threads;
              return std::make_unique<PyOdometry>(config);
            }),
            py::arg("method") = "ctf-icp")

@@ -43,7 +43,6 @@ bool near(const Pose& a, const Pose& b) {
 CoarseNdt::CoarseNdt(const OdometryConfig& config)
     : config_(config), grid_(grid_options(config.ndt_resolution)) {
   solver_ = config.registration.solver;
-  solver_.num_threads = config.threads;
   solver_.max_iterations = config.coarse_max_iterations;
   solver_.rotation_tolerance = solver_.translation_tolerance = config.coarse_tolerance;
   solver_.kernel = RobustKernel{};

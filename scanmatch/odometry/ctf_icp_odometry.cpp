@@ -7,9 +7,9 @@ namespace scanmatch {
 CtfIcpOdometry::CtfIcpOdometry(const OdometryConfig& config)
     : OdometryPipeline(config, /*keep_attributes=*/false, config.dense_sparse_map,
                        /*deskews_again=*/true),
-      coarse_(config),
-      fine_(config),
-      map_(config),
+      coarse_(this->config()),
+      fine_(this->config()),
+      map_(this->config()),
       fine_stage_(config.fine_stage) {}
 
 Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,

@@ -14,7 +14,6 @@ FineStage::FineStage(const OdometryConfig& config) {
   options_.with_cost = false;  // the odometry reads the pose, inliers and information
   SolverOptions& solver = options_.solver;
   solver = config.registration.solver;
-  solver.num_threads = config.threads;
   reported_degeneracy_ratio_ = config.degeneracy_ratio;
   guard_ratio_ = config.degeneracy_guard_ratio;
   solver.kernel = RobustKernel{};

@@ -9,7 +9,6 @@ namespace {
 RegistrationOptions registration_options(const OdometryConfig& config) {
   RegistrationOptions o = config.registration;
   o.method = config.method;
-  o.solver.num_threads = config.threads;
   return o;
 }
 
@@ -18,7 +17,7 @@ RegistrationOptions registration_options(const OdometryConfig& config) {
 FrameToFrameOdometry::FrameToFrameOdometry(const OdometryConfig& config)
     : OdometryPipeline(config, /*keep_attributes=*/true, /*map_points=*/false,
                        /*deskews_again=*/false),
-      registration_(registration_options(config)),
+      registration_(registration_options(this->config())),
       minimum_points_(minimum_points(config.method, config.registration)) {}
 
 Pose FrameToFrameOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,

@@ -30,6 +30,7 @@ OdometryPipeline::OdometryPipeline(const OdometryConfig& config, bool keep_attri
       wants_map_points_(map_points),
       deskews_again_(deskews_again) {
   check_odometry_config(config);
+  // The one place the thread count reaches the solver: every stage is made from config().
   config_.registration.solver.num_threads = config.threads;
 }
 
