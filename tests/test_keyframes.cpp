@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "scanmatch/eval/metrics.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
@@ -262,6 +263,62 @@ TEST(AdaptiveRules, ThePriorScalesWithTheTimeStepAndIsUncertainWhenTheStepIsUnkn
   EXPECT_TRUE(missed.within_gate(Pose::Identity(), beyond));
   EXPECT_FALSE(missed.within_gate(
       Pose::Identity(), from_xyz_rpy(1.01 * c.uncertain_jump_scale * c.max_jump, 0, 0, 0, 0, 0)));
+}
+
+// A steady sensor whose stamps come from a coarse clock (KITTI raw: a 0.1036 s period stamped by a
+// 100 Hz clock reads 0.10 or 0.11 s) keeps its last motion as the prior: the stamps' jitter is not
+// timing. A dropped frame still doubles the prior, and keyframes 0.4 and 0.5 s apart (a real 20 %
+// difference, never steady) are still scaled.
+TEST(AdaptiveRules, ASteadySensorsStampJitterDoesNotScaleThePrior) {
+  OdometryConfig c;
+  const Pose velocity = from_xyz_rpy(1.8, 0.0, 0.0, 0.0, 0.0, 0.002);  // a car at 18 m/s
+  const double period = 0.1036;
+  const auto stamp = [&](std::size_t frame) {  // truncated to the 100 Hz clock
+    return std::floor(period * static_cast<double>(frame) * 100.0) / 100.0;
+  };
+  MotionModel model(c);
+  std::size_t frame = 0;
+  const auto next = [&](double t) {
+    const MotionPrior prior = model.predict(t, frame);
+    if (frame > 0) model.record(velocity, false);
+    ++frame;
+    return prior;
+  };
+  for (; frame < 10;) next(stamp(frame));
+  int scaled = 0;
+  for (int k = 0; k < 30; ++k) {
+    const MotionPrior prior = next(stamp(frame));
+    EXPECT_FALSE(prior.uncertain) << "frame " << frame - 1;
+    scaled += prior.scale != 1.0;
+  }
+  EXPECT_EQ(scaled, 0);
+  // The stamps do jitter by 10 %: without the steady period half the priors would scale.
+  std::set<long> steps_ms;
+  for (std::size_t f = 10; f < 40; ++f)
+    steps_ms.insert(std::lround(1000 * (stamp(f + 1) - stamp(f))));
+  EXPECT_EQ(steps_ms, (std::set<long>{100, 110}));
+  // A dropped frame: twice the motion.
+  const MotionPrior dropped = next(stamp(frame + 1));
+  EXPECT_NEAR(dropped.scale, 2.0, 0.15);
+  EXPECT_NEAR(rotation_angle(dropped.motion), dropped.scale * 0.002, 1e-9);
+
+  // Keyframes stamped 0.4 or 0.5 s apart are scaled by their ratio.
+  MotionModel keyframes(c);
+  const double steps[] = {0.5, 0.4, 0.5, 0.5, 0.4, 0.5, 0.4, 0.4, 0.5, 0.5, 0.4, 0.5};
+  double t = 0.0;
+  double last_step = 0.0;
+  int keyframe_scaled = 0;
+  for (std::size_t i = 0; i < std::size(steps); ++i) {
+    const MotionPrior prior = keyframes.predict(t, i);
+    if (i >= 2 && last_step != steps[i - 1]) {
+      EXPECT_NEAR(prior.scale, steps[i - 1] / last_step, 1e-9) << "keyframe " << i;
+      ++keyframe_scaled;
+    }
+    if (i > 0) keyframes.record(velocity, false);
+    if (i > 0) last_step = steps[i - 1];
+    t += steps[i];
+  }
+  EXPECT_GT(keyframe_scaled, 4);
 }
 
 TEST(AdaptiveRules, APriorThatTurnsSharplyIsUncertain) {

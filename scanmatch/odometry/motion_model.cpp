@@ -8,6 +8,13 @@ namespace {
 
 /// Time-step ratios this close to 1 count as regular: timestamp jitter is not motion.
 constexpr double kRegularStep = 0.05;
+/// A sensor is steady when its last kSteadySteps time steps lie within kSteadyJitter of their
+/// mean: its steps are then its period, and their spread is stamp jitter, not timing. KITTI raw
+/// stamps come from a 100 Hz clock, so a 0.1036 s period reads as 0.10 or 0.11 s: scaled by
+/// their ratio, the prior of a car at 18 m/s missed by up to 0.2 m (half the frames uncertain).
+/// A dropped frame (twice the period) stays a real step; keyframes are never steady.
+constexpr std::size_t kSteadySteps = 8;
+constexpr double kSteadyJitter = 0.1;
 
 }  // namespace
 
@@ -19,6 +26,8 @@ MotionModel::MotionModel(const OdometryConfig& config) : config_(config) {}
 
 const MotionPrior& MotionModel::predict(double timestamp, std::size_t frames) {
   step_ = frames > 0 ? timestamp - last_timestamp_ : 0.0;
+  steady_period_ = steady_period();
+  if (step_ > 0.0) remember_step(step_);
   if (frames > 0 && timestamp > last_timestamp_) frame_period_ = timestamp - last_timestamp_;
   last_timestamp_ = timestamp;
 
@@ -38,7 +47,7 @@ void MotionModel::scale_by_time_step() {
     prior_.uncertain = true;  // no usable stamps: the step is unknown
     return;
   }
-  const double ratio = step_ / velocity_period_;
+  const double ratio = as_period(step_) / as_period(velocity_period_);
   if (std::abs(ratio - 1.0) <= kRegularStep) return;
   if (ratio > config_.max_step_ratio || ratio < 1.0 / config_.max_step_ratio) {
     // A gap (dropped frames) or a burst: scale within bounds, but trust it less.
@@ -48,6 +57,30 @@ void MotionModel::scale_by_time_step() {
     prior_.scale = ratio;
   }
   prior_.motion = scaled_motion(velocity_, prior_.scale);
+}
+
+double MotionModel::steady_period() const {
+  if (recent_steps_.size() < kSteadySteps) return 0.0;
+  const auto [lowest, highest] = std::minmax_element(recent_steps_.begin(), recent_steps_.end());
+  double sum = 0.0;
+  for (double s : recent_steps_) sum += s;
+  const double mean = sum / static_cast<double>(recent_steps_.size());
+  return *lowest >= (1.0 - kSteadyJitter) * mean && *highest <= (1.0 + kSteadyJitter) * mean ? mean
+                                                                                             : 0.0;
+}
+
+double MotionModel::as_period(double step) const {
+  return steady_period_ > 0.0 && std::abs(step / steady_period_ - 1.0) <= kSteadyJitter
+             ? steady_period_
+             : step;
+}
+
+void MotionModel::remember_step(double step) {
+  // A steady sensor's odd step (a dropped frame) is not its period; a lasting change is.
+  if (as_period(step) != step && ++odd_steps_ < kSteadySteps) return;
+  odd_steps_ = 0;
+  recent_steps_.push_back(step);
+  if (recent_steps_.size() > kSteadySteps) recent_steps_.pop_front();
 }
 
 bool MotionModel::within_gate(const Pose& predicted, const Pose& estimate) const {

@@ -3,7 +3,8 @@
 // the gate a registration result must pass, and the record of past motion it learns from.
 //
 // - Constant velocity, time-scaled: the prior is the last measured motion, scaled by the ratio of
-//   the frame time steps (keyframe folders have irregular steps).
+//   the frame time steps (keyframe folders have irregular steps). A steady sensor's steps within
+//   jitter of its period count as the period (stamps from a coarse clock are not timing).
 // - The prior is *uncertain* for the first registered frame, when the time stamps do not increase
 //   or their ratio is outside [1/max_step_ratio, max_step_ratio], after a bridged frame, and after
 //   a frame whose estimate missed its prior by more than prior_miss_distance / prior_miss_angle,
@@ -15,6 +16,7 @@
 // With regular time steps and an accurate prior, the prior is the last motion, unscaled.
 
 #include <cstddef>
+#include <deque>
 
 #include "scanmatch/core/se3.hpp"
 #include "scanmatch/odometry/odometry_config.hpp"
@@ -54,12 +56,20 @@ class MotionModel {
  private:
   /// Scales prior_ by the ratio of this time step to the last motion's (uncertain beyond bounds).
   void scale_by_time_step();
+  /// The mean of the recent time steps when they lie within jitter of it (a steady sensor), else 0.
+  double steady_period() const;
+  /// `step`, or the steady period when it lies within jitter of it.
+  double as_period(double step) const;
+  void remember_step(double step);
 
   OdometryConfig config_;
   MotionPrior prior_;
   Pose velocity_ = Pose::Identity();
   double last_timestamp_ = 0.0, step_ = 0.0, frame_period_ = 0.1;
-  double velocity_period_ = 0.0;  ///< s spanned by velocity_ (0: unknown)
+  double velocity_period_ = 0.0;     ///< s spanned by velocity_ (0: unknown)
+  std::deque<double> recent_steps_;  ///< the last positive time steps, s
+  double steady_period_ = 0.0;       ///< steady_period() before this frame's step (0: not steady)
+  std::size_t odd_steps_ = 0;        ///< consecutive steps off the steady period
   bool previous_bridged_ = false;
   bool previous_missed_ = false;  ///< the last estimate was far from its prior
 };
