@@ -51,8 +51,6 @@ Map2DRunOptions configuration(const Map2DCommand& c, const CLI::App& cmd) {
 
 void add_map2d_command(CLI::App& app) {
   auto c = std::make_shared<Map2DCommand>();
-  // Scans of the classic logs are up to 1.5 m and 78 deg apart: the search is on by default.
-  c->run.mapper.registration.search_window = 1.3;
   // From the previous step's motion: with the filled search the identity gained nothing on these
   // stop-and-go logs and lost intel's loop-closed ATE (0.34 against 0.27 m, docs/planar.md).
   c->run.mapper.constant_velocity = true;

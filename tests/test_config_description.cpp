@@ -216,7 +216,7 @@ TEST(ConfigDescription, Map2DRunsReloadWithConfigAndGivenFlagsWin) {
   const Map2DRunOptions written = read_map2d_config(first + "/config.json");
   EXPECT_EQ(written.mapper.registration.method, "pl-icp");
   EXPECT_NEAR(written.mapper.registration.search_angle, 30 * M_PI / 180, 1e-12);
-  EXPECT_DOUBLE_EQ(written.mapper.registration.search_window, 1.3);  // the command's default
+  EXPECT_DOUBLE_EQ(written.mapper.registration.search_window, 1.3);  // the mapper's default
 
   // The same configuration again gives the same poses; a flag given on top wins over the file.
   ASSERT_EQ(testing::run_cli(common + "--config " + first + "/config.json --out " + again).status,

@@ -605,8 +605,8 @@ TEST(Map2D, WideSearchFindsATurnBeyondTheSearchAngle) {
   const Pose2 start = pose2(2.0, 1.5, 0.0), turned = pose2(2.1, 1.6, 75 * M_PI / 180);
   Mapper2DConfig config;
   config.constant_velocity = false;
-  config.registration.search_window = 1.3;
   config.registration.search_angle = 45 * M_PI / 180;
+  ASSERT_GT(config.registration.search_window, 0.0);     // the search is on by default
   ASSERT_GE(config.wide_search_angle, 80 * M_PI / 180);  // on by default
   const auto second_pose = [&](const Mapper2DConfig& c) {
     Mapper2D mapper(c);
@@ -654,7 +654,6 @@ TEST(Map2D, WholeTurnSearchFindsACornerBeyondTheWideSearch) {
     return worst;
   };
   Mapper2DConfig config;
-  config.registration.search_window = 1.3;        // map2d's default
   ASSERT_GT(config.full_turn_search_below, 0.0);  // on by default
   const double whole = worst_turn_error(config, 130, 170);
   EXPECT_LT(whole, 3.0);
@@ -689,7 +688,6 @@ TEST(Map2D, SimulatedCorridorsKeepTheirStepsAndTurnTheirCorners) {
     return absolute_trajectory_error_2d(reference, estimate).rmse;
   };
   Mapper2DConfig config;
-  config.registration.search_window = 1.3;  // map2d's default
   const double prior = ate(config);
   EXPECT_GT(from_prior, 0u);
   config.open_step_prior_distance = 1e9;
@@ -732,7 +730,6 @@ TEST(Map2D, LongSearchFindsAStepBeyondTheWindow) {
   const Pose2 start = pose2(0.8, 1.0, 0.0), moved = pose2(3.4, 1.3, 0.1);
   Mapper2DConfig config;
   config.constant_velocity = false;
-  config.registration.search_window = 1.3;    // map2d's default
   ASSERT_GT(config.long_search_window, 3.0);  // on by default
   const auto second_step = [&](const Mapper2DConfig& c, bool* searched = nullptr) {
     Mapper2D mapper(c);
@@ -753,7 +750,6 @@ TEST(Map2D, LongSearchFindsAStepBeyondTheWindow) {
   // A step within the window fits well from the first search: no long search.
   config = Mapper2DConfig{};
   config.constant_velocity = false;
-  config.registration.search_window = 1.3;
   Mapper2D mapper(config);
   mapper.add_scan(room_scan(start));
   mapper.add_scan(room_scan(pose2(1.2, 1.1, 0.05)));
@@ -771,7 +767,6 @@ TEST(Map2D, LongSearchKeepsOrebrosCorridorSteps) {
   ASSERT_EQ(input.scans.size(), 41u);
   const std::vector<LaserScan2D> scans(input.scans.begin() + 24, input.scans.end());
   Mapper2DConfig config;
-  config.registration.search_window = 1.3;
   const int with_long = off_steps(config, scans);
   config.long_search_window = 0.0;
   const int without = off_steps(config, scans);
@@ -805,7 +800,6 @@ TEST(Map2D, DeskewingStaysStableOnADistortedSequence) {
   const auto one_step_rotation = [&](bool deskew) {
     Mapper2DConfig config;
     config.registration.method = "pl-icp";
-    config.registration.search_window = 1.3;
     config.constant_velocity = false;
     config.deskew = deskew;
     Mapper2D mapper(config);
@@ -1031,7 +1025,6 @@ TEST(Map2D, RealCarmenLogBeatsTheCsmBaseline) {
   Map2DRunOptions options;
   options.quiet = true;
   options.mapper.constant_velocity = false;
-  options.mapper.registration.search_window = 1.3;
   const Map2DSummary s = run_map2d(load_scans_2d(log, {}, 300), dir.path().string(), options);
   EXPECT_LT(s.one_step.mean_translation, 0.15);
   EXPECT_LT(s.one_step.median_translation, 0.05);

@@ -15,7 +15,9 @@ namespace scanmatch {
 class Reference2D;  // registration/planar/reference2d.hpp
 
 struct Mapper2DConfig {
-  Registration2DOptions registration;
+  /// The step's registration, with the correlative search on (+- 1.3 m; register2d's is off):
+  /// scans of the classic logs are up to 1.5 m and 78 deg apart.
+  Registration2DOptions registration{.search_window = 1.3};
   /// Initial guess of each step: the previous step's motion (constant velocity) or none (the
   /// identity). The paper chains with the previous result.
   bool constant_velocity = true;
