@@ -9,6 +9,7 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "options.hpp"
+#include "records.hpp"
 #include "scanmatch/odometry/odometry.hpp"
 #include "scanmatch/odometry/odometry_pipeline.hpp"
 
@@ -66,23 +67,10 @@ class PyOdometry {
   std::vector<FrameStats> stats_;
 };
 
-// Every field of the description (frame_stats.hpp) by its key.
-py::dict stats_dict(const FrameStats& s) {
-  py::dict d;
-  for_each_field(s, [&](const char* key, const auto& field, const char*) { d[key] = field; });
-  return d;
-}
-
-// The docstring of last_stats: each key with its help text.
+// The docstring of last_stats: each key of the description (frame_stats.hpp) with its help text.
 const char* stats_doc() {
-  static const std::string doc = [] {
-    std::string text = "timing and diagnostics of the last frame (dict), None before the first:";
-    const FrameStats defaults;
-    for_each_field(defaults, [&](const char* key, const auto&, const char* help) {
-      text += std::string("\n  ") + key + ": " + help;
-    });
-    return text;
-  }();
+  static const std::string doc = record_doc<FrameStats>(
+      "timing and diagnostics of the last frame (dict), None before the first:");
   return doc.c_str();
 }
 
@@ -133,14 +121,14 @@ bad shapes raise ValueError.)doc")
           "last_stats",
           [](const PyOdometry& o) -> py::object {
             if (o.stats().empty()) return py::none();
-            return stats_dict(o.stats().back());
+            return record_dict(o.stats().back());
           },
           stats_doc())
       .def_property_readonly(
           "stats",
           [](const PyOdometry& o) {
             py::list out;
-            for (const auto& s : o.stats()) out.append(stats_dict(s));
+            for (const auto& s : o.stats()) out.append(record_dict(s));
             return out;
           },
           "last_stats of every frame (list of dicts)")

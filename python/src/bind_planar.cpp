@@ -9,6 +9,7 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "options.hpp"
+#include "records.hpp"
 #include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/mapping2d/mapper2d.hpp"
@@ -61,17 +62,11 @@ class PyMapper2D {
   std::vector<Scan2DStats> stats_;
 };
 
-py::dict stats_dict(const Scan2DStats& s) {
-  py::dict d;
-  d["ms"] = s.ms;
-  d["iterations"] = s.iterations;
-  d["points"] = s.points;
-  d["pairs"] = s.pairs;
-  d["error"] = s.error;
-  d["bridged"] = s.bridged;
-  d["open_step_from_prior"] = s.open_step_from_prior;
-  d["weak_fit"] = s.weak_fit;
-  return d;
+// The docstring of Mapper2D.last_stats: each key of the description (scan2d_stats.hpp).
+const char* stats_doc() {
+  static const std::string doc = record_doc<Scan2DStats>(
+      "timing and diagnostics of the last scan (dict), None before the first:");
+  return doc.c_str();
 }
 
 }  // namespace
@@ -171,15 +166,17 @@ motion prior (last_stats["bridged"]).)doc")
       .def_property_readonly(
           "poses", [](const PyMapper2D& p) { return poses2_to_array(p.poses()); },
           "(N, 3, 3) float64 copy of every pose returned so far")
-      .def_property_readonly("last_stats",
-                             [](const PyMapper2D& p) -> py::object {
-                               if (p.stats().empty()) return py::none();
-                               return stats_dict(p.stats().back());
-                             })
+      .def_property_readonly(
+          "last_stats",
+          [](const PyMapper2D& p) -> py::object {
+            if (p.stats().empty()) return py::none();
+            return record_dict(p.stats().back());
+          },
+          stats_doc())
       .def_property_readonly("stats",
                              [](const PyMapper2D& p) {
                                py::list out;
-                               for (const auto& s : p.stats()) out.append(stats_dict(s));
+                               for (const auto& s : p.stats()) out.append(record_dict(s));
                                return out;
                              })
       .def_property_readonly("config",

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "scanmatch/core/scan2d.hpp"
+#include "scanmatch/mapping2d/scan2d_stats.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
@@ -81,24 +82,6 @@ struct Mapper2DConfig {
   /// short along a corridor; within +-1.3 m of that prior only a wrong pose fits. 0: off.
   double long_search_window = 3.5;
   double long_search_below = 0.7;
-};
-
-struct Scan2DStats {
-  double ms = 0.0;  ///< registration time
-  int iterations = 0;
-  std::size_t points = 0, pairs = 0;
-  double error = 0.0;    ///< mean distance of the final correspondences, m
-  bool bridged = false;  ///< the scan could not be registered: the motion prior was used
-  /// The scans left the step open and the motion prior chose along it (open_step_window).
-  bool open_step_from_prior = false;
-  /// The long search ran (long_search_window), and whether its pose won.
-  bool long_search = false, long_search_won = false;
-  /// Few points fit even after the wide search (full_turn_search_below): the step's rotation is
-  /// in doubt, whichever search won.
-  bool weak_fit = false;
-  /// Share of the points within 15 cm of the reference's surfaces at the searched pose (before
-  /// the fine stage); -1 where no search ran. The step's health beside its error.
-  double fit = -1.0;
 };
 
 class Mapper2D {

@@ -1,22 +1,19 @@
 #pragma once
-// A frame's timing and diagnostics (Odometry::last_stats()) and the one description of them:
-// every field's key, the field and a help text. Everything that writes or reads the statistics
-// comes from describe(): timing.csv's columns and rows and its reader (below), the per-stage mean
-// and max of summary.json, and Python's Odometry.stats dictionaries. A new statistic is a member
-// of FrameStats and one line in describe().
-//
-// A visitor provides
-//   template <class T> void operator()(const char* key, T& field, const char* help);
-//   void stage(const char* key, double& ms, const char* stage, const char* help);
-// stage() is the time of a pipeline stage in ms: summary.json reports its mean and max under
-// "stages" as `stage`. A visitor of a const FrameStats gets const fields. for_each_field() visits
-// both kinds with one callable.
+// A frame's timing and diagnostics (Odometry::last_stats()) and the one description of them, a
+// record (core/record.hpp): every field's key, the field and a help text. Everything that writes
+// or reads the statistics comes from describe(): timing.csv's columns and rows and its reader
+// (below, io/record_csv.hpp), the per-stage mean and max of summary.json, and Python's
+// Odometry.stats dictionaries. A new statistic is a member of FrameStats and one line in
+// describe(). stage() is the time of a pipeline stage in ms: summary.json reports its mean and max
+// under "stages" as `stage`.
 
 #include <concepts>
 #include <cstddef>
 #include <string>
 #include <type_traits>
 #include <vector>
+
+#include "scanmatch/core/record.hpp"
 
 namespace scanmatch {
 
@@ -73,28 +70,6 @@ void describe(Stats& s, Visitor& v) {
     "ctf-icp: rotation between the coarse and fine result, deg");
 }
 
-namespace frame_stats_detail {
-template <typename F>
-struct EveryField {
-  F& f;
-  template <typename T>
-  void operator()(const char* key, T& field, const char* help) {
-    f(key, field, help);
-  }
-  template <typename T>
-  void stage(const char* key, T& ms, const char*, const char* help) {
-    f(key, ms, help);
-  }
-};
-}  // namespace frame_stats_detail
-
-/// Calls f(key, field, help) for every field of `stats`, stage times included.
-template <typename Stats, typename F>
-void for_each_field(Stats& stats, F&& f) {
-  frame_stats_detail::EveryField<std::remove_reference_t<F>> visitor{f};
-  describe(stats, visitor);
-}
-
 // timing.csv: a header line "index,timestamp,<every key of describe()>", then a row a frame.
 // Stage times have 3 decimals, other numbers 6 significant digits, `bridged` is 0 or 1.
 
@@ -102,11 +77,7 @@ std::string timing_csv_header();
 std::string timing_csv_row(std::size_t index, double timestamp, const FrameStats& stats);
 
 /// One row of timing.csv read back.
-struct FrameRecord {
-  std::size_t index = 0;
-  double timestamp = 0;
-  FrameStats stats;
-};
+using FrameRecord = TimingRow<FrameStats>;
 
 /// Reads timing.csv by column name: columns it does not know (a newer file) are skipped, fields
 /// without a column (an older file) keep their defaults. Throws Error naming the file and line

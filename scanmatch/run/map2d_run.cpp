@@ -12,9 +12,9 @@
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/io/file_util.hpp"
-#include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/run/run_config.hpp"
+#include "scanmatch/run/run_record.hpp"
 
 namespace scanmatch {
 namespace {
@@ -82,15 +82,12 @@ void write_map(const OccupancyGrid& grid, const std::string& base) {
 
 Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
                        const Map2DRunOptions& options) {
-  std::error_code ec;
-  fs::create_directories(run_folder, ec);
-  if (ec) throw Error(run_folder + ": cannot create the run folder: " + ec.message());
+  create_run_folder(run_folder);
   const auto file = [&](const std::string& name) { return (fs::path(run_folder) / name).string(); };
   Mapper2D mapper(options.mapper);
   OccupancyGrid grid(options.grid), reference_grid(options.grid);
   TrajectoryWriter poses(file("poses_tum.txt"), TrajectoryFormat::kTum);
-  LineWriter timing(file("timing.csv"));
-  timing.line("scan,ms,iterations,points,pairs,error_m,bridged,open_step_from_prior,fit,weak_fit");
+  TimingWriter<Scan2DStats> timing(file("timing.csv"));
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
@@ -131,11 +128,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     estimate.push_back(pose);
     reference.push_back(pose2(laser.pose));
     poses.write(to_pose3(pose), laser.timestamp);
-    char row[512];
-    std::snprintf(row, sizeof row, "%zu,%.4f,%d,%zu,%zu,%.6f,%d,%d,%.3f,%d", i, s.ms, s.iterations,
-                  s.points, s.pairs, s.error, s.bridged ? 1 : 0, s.open_step_from_prior ? 1 : 0,
-                  s.fit, s.weak_fit ? 1 : 0);
-    timing.line(row);
+    timing.write(i, laser.timestamp, s);
     // A trajectory that ran away (a failed method on hard data) can need more cells than the
     // grid allows: the run goes on and keeps its poses, without that map.
     const auto insert = [&](OccupancyGrid& g, std::string& error, const Pose2& at) {
@@ -198,9 +191,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
         optimized_map_error = e.what();
       }
     }
-    const std::string tum = file("poses_optimized_tum.txt");
-    write_trajectory(tum + ".tmp", optimized_trajectory, TrajectoryFormat::kTum);
-    fs::rename(tum + ".tmp", tum);
+    write_trajectory_atomic(file("poses_optimized_tum.txt"), optimized_trajectory,
+                            TrajectoryFormat::kTum);
     for (const Loop2D& l : loop_closure->loops()) {
       summary.accepted_loops += !l.outlier;
       if (l.outlier) continue;
@@ -267,6 +259,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   }
   const Registration2DOptions& r = options.mapper.registration;
   nlohmann::ordered_json j;
+  j["kind"] = kMap2DRunKind;
   j["input"] = input.description;
   j["method"] = r.method;
   j["options"] = {

@@ -65,8 +65,10 @@ struct Map2DSummary {
   std::string map_error, reference_map_error;
 };
 
-/// Writes RUNDIR/poses_tum.txt and timing.csv (flushed per scan), poses_reference_tum.txt,
-/// summary.json, config.json (the options, for `map2d --config`) and map.{pgm,yaml,png}
+/// Writes RUNDIR/poses_tum.txt and timing.csv (flushed per scan: index, timestamp and the fields
+/// of Scan2DStats' description, mapping2d/scan2d_stats.hpp), poses_reference_tum.txt,
+/// summary.json ("kind": "map2d"), config.json (the options, for `map2d --config`) and
+/// map.{pgm,yaml,png}
 /// (atomically); with loop_closure also poses_optimized_tum.txt, loops.json and
 /// map_odometry.{pgm,yaml,png}.
 Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,

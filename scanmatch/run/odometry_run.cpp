@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
-#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -18,12 +17,12 @@
 #include "scanmatch/geometry/voxel_key.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
-#include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/health.hpp"
 #include "scanmatch/odometry/spin_times.hpp"
 #include "scanmatch/run/run_config.hpp"
+#include "scanmatch/run/run_record.hpp"
 
 namespace scanmatch {
 namespace {
@@ -180,14 +179,6 @@ nlohmann::ordered_json loops_json(const std::vector<Loop3D>& loops,
   return j;
 }
 
-void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
-                             TrajectoryFormat format) {
-  write_trajectory(path + ".tmp", trajectory, format);
-  std::error_code ec;
-  std::filesystem::rename(path + ".tmp", path, ec);
-  if (ec) fail(path, "cannot replace the file: " + ec.message());
-}
-
 }  // namespace
 
 const StageStatistics& RunSummary::stage(std::string_view name) const {
@@ -209,16 +200,13 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     throw Error("map format must be pcd or ply (got '" + options.map_format + "')");
   if (!(options.map_voxel_size > 0.0)) throw Error("map export voxel size must be positive");
   std::unique_ptr<TrajectoryWriter> kitti, tum;
-  std::unique_ptr<LineWriter> timing;
+  std::unique_ptr<TimingWriter<FrameStats>> timing;
   if (write) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) fail(dir, "cannot create the run folder: " + ec.message());
+    create_run_folder(dir);
     write_file_atomic(dir + "/config.json", odometry_run_config_to_json({config, options}));
     kitti = std::make_unique<TrajectoryWriter>(dir + "/poses.txt", TrajectoryFormat::kKitti);
     tum = std::make_unique<TrajectoryWriter>(dir + "/poses_tum.txt", TrajectoryFormat::kTum);
-    timing = std::make_unique<LineWriter>(dir + "/timing.csv");
-    timing->line(timing_csv_header());
+    timing = std::make_unique<TimingWriter<FrameStats>>(dir + "/timing.csv");
   }
   const std::size_t total =
       options.max_frames > 0 ? std::min(options.max_frames, source.size()) : source.size();
@@ -339,7 +327,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     if (settled) settle_poses();
     if (write) {
       if (settled) write_poses_until(summary.frames + 1);
-      timing->line(timing_csv_row(summary.frames, frame.timestamp, s));
+      timing->write(summary.frames, frame.timestamp, s);
     }
     // A bridged frame has no registered points of its own (an empty frame leaves the previous
     // one in last_frame()); it would only add a copy or a guess to the map.
@@ -419,7 +407,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                         loops_json(loop_closure->loops(), reported_from_registered).dump(2) + "\n");
     }
     write_ground_truth(dir, truth, summary);
-    nlohmann::ordered_json j = {{"method", summary.method},
+    nlohmann::ordered_json j = {{"kind", kOdometryRunKind},
+                                {"method", summary.method},
                                 {"source", summary.source},
                                 {"frames", summary.frames},
                                 {"bridged_frames", summary.bridged_frames},

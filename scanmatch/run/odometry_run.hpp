@@ -8,8 +8,9 @@
 //                   description (frame_stats.hpp): preprocess_ms,coarse_ms,fine_ms,map_ms,total_ms,
 //                   points_in,points_downsampled,iterations,condition_number,
 //                   degenerate_directions,bridged
-//   summary.json    method, options (the whole configuration), frames, mean and max ms of each
-//                   stage of frame_stats.hpp, frames per second, the run's wall ms per frame,
+//   summary.json    "kind": "odometry" (run_record.hpp), method, options (the whole
+//                   configuration), frames, mean and max ms of each stage of frame_stats.hpp,
+//                   frames per second, the run's wall ms per frame,
 //                   whether the run was interrupted, the error that ended it early, and the ATE
 //                   when the source has ground truth (written atomically at the end, also after
 //                   such an error)

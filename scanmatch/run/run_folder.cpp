@@ -1,11 +1,14 @@
 #include "scanmatch/run/run_folder.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/file_util.hpp"
+#include "scanmatch/io/record_csv.hpp"
+#include "scanmatch/run/run_record.hpp"
 
 namespace scanmatch {
 
@@ -29,24 +32,40 @@ RunFolder read_run_folder(const std::string& path) {
     run.ground_truth = read_trajectory(path + "/poses_gt.txt");
   else if (fs::exists(path + "/poses_reference_tum.txt"))  // map2d: the log's corrected poses
     run.ground_truth = read_trajectory(path + "/poses_reference_tum.txt");
-  // map2d's timing.csv (one row per scan: scan,ms,...) has none of the 3D stages or health
-  // fields; its runs are shown without the per-frame plots.
   const std::string timing = path + "/timing.csv";
+  std::vector<std::string> header;  // timing.csv's columns
   if (fs::exists(timing)) {
     std::ifstream in(timing);
-    std::string header;
-    std::getline(in, header);
-    if (header.rfind("scan,ms,", 0) != 0) run.timing = read_timing_csv(timing);
+    std::string line;
+    std::getline(in, line);
+    header = record_csv_detail::split_cells(line);
   }
+  bool kind_given = false;
   if (fs::exists(path + "/summary.json")) {
     try {
       const auto j = nlohmann::json::parse(read_file_bytes(path + "/summary.json"));
       run.method = j.value("method", std::string("?"));
       run.frames_per_second = j.value("frames_per_second", j.value("scans_per_second", 0.0));
       run.interrupted = j.value("interrupted", false);
+      if (j.contains("kind")) {
+        run.kind = j.at("kind").get<std::string>();
+        kind_given = true;
+      }
     } catch (const nlohmann::json::exception& e) {
       fail(path + "/summary.json", std::string("malformed: ") + e.what());
     }
+    if (run.kind != kOdometryRunKind && run.kind != kMap2DRunKind)
+      fail(path + "/summary.json", "unknown kind of run '" + run.kind + "'");
+  }
+  // Older folders (and runs that never wrote summary.json): map2d's timing.csv has no total_ms.
+  if (!kind_given && !header.empty() &&
+      std::find(header.begin(), header.end(), "total_ms") == header.end())
+    run.kind = kMap2DRunKind;
+  if (fs::exists(timing)) {
+    if (run.kind == kOdometryRunKind)
+      run.timing = read_timing_csv(timing);
+    else if (header.empty() || header.front() != "scan")  // older "scan,ms,...": not read
+      run.scan_timing = read_record_csv<Scan2DStats>(timing, "ms");
   }
   run.has_map = fs::exists(path + "/map.pcd");
   if (fs::exists(path + "/poses_optimized_tum.txt"))

@@ -1,0 +1,24 @@
+#include "scanmatch/run/run_record.hpp"
+
+#include <filesystem>
+#include <system_error>
+
+#include "scanmatch/core/error.hpp"
+
+namespace scanmatch {
+
+void create_run_folder(const std::string& path) {
+  std::error_code ec;
+  std::filesystem::create_directories(path, ec);
+  if (ec) fail(path, "cannot create the run folder: " + ec.message());
+}
+
+void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
+                             TrajectoryFormat format) {
+  write_trajectory(path + ".tmp", trajectory, format);
+  std::error_code ec;
+  std::filesystem::rename(path + ".tmp", path, ec);
+  if (ec) fail(path, "cannot replace the file: " + ec.message());
+}
+
+}  // namespace scanmatch

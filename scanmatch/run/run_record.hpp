@@ -1,0 +1,43 @@
+#pragma once
+// What every run folder shares, 2D (map2d_run) and 3D (odometry_run): the folder, what kind of
+// run it holds (summary.json's "kind", which run_folder reads back), timing.csv with a row per
+// scan or frame from its record's description (core/record.hpp), whole files written atomically.
+
+#include <cstddef>
+#include <string>
+
+#include "scanmatch/io/line_writer.hpp"
+#include "scanmatch/io/record_csv.hpp"
+#include "scanmatch/io/trajectory.hpp"
+
+namespace scanmatch {
+
+/// summary.json's "kind" of a run folder: `scanmatch odometry` (3D, timing.csv of FrameStats) or
+/// `scanmatch map2d` (2D, timing.csv of Scan2DStats).
+inline constexpr const char* kOdometryRunKind = "odometry";
+inline constexpr const char* kMap2DRunKind = "map2d";
+
+/// Creates RUNDIR and its parents; throws Error naming it when it cannot.
+void create_run_folder(const std::string& path);
+
+/// timing.csv: the header of Record's description, then a row per scan or frame, each flushed
+/// (an interrupted run keeps its rows).
+template <typename Record>
+class TimingWriter {
+ public:
+  explicit TimingWriter(const std::string& path) : out_(path) {
+    out_.line(record_csv_header<Record>());
+  }
+  void write(std::size_t index, double timestamp, const Record& record) {
+    out_.line(record_csv_row(index, timestamp, record));
+  }
+
+ private:
+  LineWriter out_;
+};
+
+/// Writes a whole trajectory atomically (tmp + rename); throws Error naming the file.
+void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
+                             TrajectoryFormat format);
+
+}  // namespace scanmatch
