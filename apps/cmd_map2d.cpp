@@ -136,15 +136,15 @@ void add_map2d_command(CLI::App& app) {
       };
       print_ate("of the odometry", s.ate_odometry, s.all_pairs_odometry);
       if (s.loop_closure) {
+        const auto& l = *s.loop_closure;
         fmt::print(
             "loop closure: {} keyframes, {} candidates, {} verified, {} accepted ({} outliers), "
             "{:.2f} ms per scan {}; the run took {:.2f} ms per scan{}\n",
-            s.loops.keyframes, s.loops.candidates, s.loops.verified, s.accepted_loops,
-            s.loops.outliers, s.loop_ms_per_scan,
-            s.loop_closure_thread ? "on its own thread" : "inline", s.wall_ms_per_scan,
-            s.loop_closure_thread
-                ? fmt::format(", {:.2f} of it waiting for loop closure", s.loop_wait_ms_per_scan)
-                : std::string());
+            l.counts.keyframes, l.counts.candidates, l.counts.verified, l.accepted,
+            l.counts.outliers, l.ms_per_item, l.thread ? "on its own thread" : "inline",
+            s.wall_ms_per_scan,
+            l.thread ? fmt::format(", {:.2f} of it waiting for loop closure", l.wait_ms_per_item)
+                     : std::string());
         print_ate("loop-closed", s.ate_optimized, s.all_pairs_optimized);
       }
       if (s.map_agreement >= 0)

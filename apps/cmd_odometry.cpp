@@ -66,15 +66,13 @@ void run_command(OdometryCommand& c, const CLI::App& cmd) {
     if (!accuracy.empty())
       std::printf("%s%s\n", accuracy.c_str(), summary.loop_closure ? " (odometry)" : "");
     if (summary.loop_closure) {
-      const LoopClosure3DCounts& l = summary.loops;
+      const auto& l = *summary.loop_closure;
       std::printf(
           "loop closure: %zu keyframes, %zu candidates, %zu verified, %zu accepted (%zu "
           "outliers), %.2f ms per frame %s; the run took %.2f ms per frame",
-          l.keyframes, l.candidates, l.verified, summary.accepted_loops, l.outliers,
-          summary.loop_ms_per_frame, summary.loop_closure_thread ? "on its own thread" : "inline",
-          summary.wall_ms_per_frame);
-      if (summary.loop_closure_thread)
-        std::printf(", %.2f of it waiting for loop closure", summary.loop_wait_ms_per_frame);
+          l.counts.keyframes, l.counts.candidates, l.counts.verified, l.accepted, l.counts.outliers,
+          l.ms_per_item, l.thread ? "on its own thread" : "inline", summary.wall_ms_per_frame);
+      if (l.thread) std::printf(", %.2f of it waiting for loop closure", l.wait_ms_per_item);
       std::printf("\n");
       if (const auto& ate = summary.ate_optimized; ate && ate->path_length > 0.0)
         std::printf("ATE loop-closed %.3f m RMSE, %.3f %% of the %.1f m path\n", ate->rmse,

@@ -338,14 +338,15 @@ TEST(LoopClosure3D, OnItsOwnThreadItClosesTheSameLoopsAsInline) {
   inline_options.loop_closure_thread = false;
   const RunSummary inline_run =
       run_with_loop_closure(*inline_source, dir.file("inline"), inline_options);
-  EXPECT_GT(threaded.accepted_loops, 0u);  // so that the comparison means something
-  EXPECT_EQ(threaded.accepted_loops, inline_run.accepted_loops);
+  ASSERT_TRUE(threaded.loop_closure && inline_run.loop_closure);
+  EXPECT_GT(threaded.loop_closure->accepted, 0u);  // so that the comparison means something
+  EXPECT_EQ(threaded.loop_closure->accepted, inline_run.loop_closure->accepted);
   ASSERT_EQ(threaded.optimized_poses.size(), inline_run.optimized_poses.size());
   for (std::size_t i = 0; i < threaded.optimized_poses.size(); ++i)
     EXPECT_EQ(threaded.optimized_poses[i].matrix(), inline_run.optimized_poses[i].matrix()) << i;
   expect_same_loop_closed_runs(dir.file("thread"), dir.file("inline"));
-  EXPECT_TRUE(threaded.loop_closure_thread);
-  EXPECT_FALSE(inline_run.loop_closure_thread);
+  EXPECT_TRUE(threaded.loop_closure->thread);
+  EXPECT_FALSE(inline_run.loop_closure->thread);
   const auto summary = [&](const std::string& name) {
     return nlohmann::json::parse(std::ifstream(dir.file(name + "/summary.json")));
   };

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "scanmatch/io/record_csv.hpp"
+#include "scanmatch/mapping/loop_counts.hpp"
 #include "scanmatch/run/map2d_run.hpp"
 #include "scanmatch/run/odometry_run.hpp"
 #include "scanmatch/run/run_folder.hpp"
@@ -36,8 +37,8 @@ std::vector<std::string> csv_columns(const std::string& path) {
   return record_csv_detail::split_cells(text.substr(0, text.find('\n')));
 }
 
-nlohmann::json read_json(const std::string& path) {
-  return nlohmann::json::parse(read_text(path));
+nlohmann::ordered_json read_json(const std::string& path) {
+  return nlohmann::ordered_json::parse(read_text(path));
 }
 
 // A short map2d run and a short odometry run, both with loop closure, shared by the tests.
@@ -140,4 +141,31 @@ TEST_F(RunRecord, FoldersWithoutAKindAreToldByTheirTimingCsv) {
   write_text(old.file("3d/summary.json"), R"({"kind": "map3d"})");
   EXPECT_EQ(scanmatch::testing::error_of([&] { read_run_folder(old.file("3d")); }),
             old.file("3d/summary.json") + ": unknown kind of run 'map3d'");
+}
+
+TEST_F(RunRecord, SummaryLoopClosureHasTheDescribedCountsThenTheRunsOwn) {
+  const auto keys_of = [](const nlohmann::ordered_json& j) {
+    std::vector<std::string> keys;
+    for (const auto& item : j.items()) keys.push_back(item.key());
+    return keys;
+  };
+  const auto expected = [](std::vector<std::string> keys, const std::string& item) {
+    for (const std::string& key :
+         {std::string("accepted"), "ms_per_" + item, std::string("thread"), "wait_ms_per_" + item})
+      keys.push_back(key);
+    return keys;
+  };
+  const nlohmann::ordered_json map2d = read_json(map2d_file("summary.json")).at("loop_closure");
+  const nlohmann::ordered_json odometry =
+      read_json(odometry_file("summary.json")).at("loop_closure");
+  EXPECT_EQ(keys_of(map2d), expected(described_keys<LoopClosure2DCounts>(), "scan"));
+  EXPECT_EQ(keys_of(odometry), expected(described_keys<LoopClosure3DCounts>(), "frame"));
+  // The values are the run's.
+  ASSERT_TRUE(map2d_->loop_closure && odometry_->loop_closure);
+  EXPECT_EQ(map2d.at("keyframes").get<std::size_t>(), map2d_->loop_closure->counts.keyframes);
+  EXPECT_GT(map2d_->loop_closure->counts.keyframes, 1u);
+  EXPECT_EQ(map2d.at("rejected_as_outliers").get<std::size_t>(),
+            map2d_->loop_closure->counts.outliers);
+  EXPECT_EQ(odometry.at("keyframes").get<std::size_t>(), odometry_->loop_closure->counts.keyframes);
+  EXPECT_EQ(odometry.at("thread").get<bool>(), odometry_->loop_closure->thread);
 }

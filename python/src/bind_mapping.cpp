@@ -7,8 +7,10 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "options.hpp"
+#include "records.hpp"
 #include "scanmatch/mapping/loop_closure2d.hpp"
 #include "scanmatch/mapping/loop_closure3d.hpp"
+#include "scanmatch/mapping/loop_counts.hpp"
 
 namespace scanmatch::python {
 namespace {
@@ -42,35 +44,11 @@ py::dict loop_dict(const Loop3D& l) {
   return d;
 }
 
-py::dict counts_dict(const LoopClosure3DCounts& c) {
-  py::dict d;
-  d["keyframes"] = c.keyframes;
-  d["candidates"] = c.candidates;
-  d["verified"] = c.verified;
-  d["rejected_by_verification"] = c.rejected_by_verification;
-  d["rejected_by_estimate"] = c.rejected_by_estimate;
-  d["ruled_out_by_estimate"] = c.ruled_out_by_estimate;
-  d["outliers"] = c.outliers;
-  d["optimizations"] = c.optimizations;
-  d["total_ms"] = c.total_ms;
-  return d;
-}
-
-py::dict counts_dict(const LoopClosure2DCounts& c) {
-  py::dict d;
-  d["keyframes"] = c.keyframes;
-  d["candidates"] = c.candidates;
-  d["verified"] = c.verified;
-  d["sliding"] = c.sliding;
-  d["rejected_by_verification"] = c.rejected_by_verification;
-  d["rejected_by_estimate"] = c.rejected_by_estimate;
-  d["outliers"] = c.outliers;
-  d["optimizations"] = c.optimizations;
-  d["open_odometry_edges"] = c.open_odometry_edges;
-  d["rotation_open_odometry_edges"] = c.rotation_open_odometry_edges;
-  d["turned_at_open_rotation"] = c.turned_at_open_rotation;
-  d["total_ms"] = c.total_ms;
-  return d;
+// The docstring of counts: each key of the description (mapping/loop_counts.hpp).
+template <typename Counts>
+const char* counts_doc() {
+  static const std::string doc = record_doc<Counts>("what loop closure did so far (dict):");
+  return doc.c_str();
 }
 
 }  // namespace
@@ -124,8 +102,8 @@ it became a keyframe (and loops were looked for).)doc")
           "Accepted loop edges as dicts (from_scan, to_scan, relative 3x3, paired_fraction, "
           "error m, outlier)")
       .def_property_readonly(
-          "counts", [](const LoopClosure2D& lc) { return counts_dict(lc.counts()); },
-          "keyframes, candidates, verified, rejections, outliers, optimizations, total_ms")
+          "counts", [](const LoopClosure2D& lc) { return record_dict(lc.counts()); },
+          counts_doc<LoopClosure2DCounts>())
       .def("__len__", &LoopClosure2D::scans);
 
   py::class_<LoopClosure3D>(m, "LoopClosure3D", R"doc(
@@ -176,8 +154,8 @@ looked for).)doc")
           "Accepted loop edges as dicts (from_frame, to_frame, relative 4x4, overlap, error m, "
           "outlier)")
       .def_property_readonly(
-          "counts", [](const LoopClosure3D& lc) { return counts_dict(lc.counts()); },
-          "keyframes, candidates, verified, rejections, outliers, optimizations, total_ms")
+          "counts", [](const LoopClosure3D& lc) { return record_dict(lc.counts()); },
+          counts_doc<LoopClosure3DCounts>())
       .def("__len__", &LoopClosure3D::frames);
 
   m.def(

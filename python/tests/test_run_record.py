@@ -53,6 +53,30 @@ class RunRecord2D(unittest.TestCase):
         xy = self.mapper.poses[:, :2, 2]
         np.testing.assert_allclose(xy, self.cli_poses[:, 1:3], atol=1e-6)
 
+    def test_loop_counts_have_summary_jsons_keys(self):
+        run_keys = ["accepted", "ms_per_scan", "thread", "wait_ms_per_scan"]
+        counts = list(scanmatch.LoopClosure2D().counts)
+        self.assertEqual(counts + run_keys, list(self.summary["loop_closure"]))
+        self.assertIn("rejected_as_outliers", counts)
+
+
+@unittest.skipUnless(os.environ.get("SCANMATCH_CLI"), "SCANMATCH_CLI not set")
+class RunRecord3D(unittest.TestCase):
+    def test_a_run_folder_says_what_it_is_and_loop_counts_have_its_keys(self):
+        with tempfile.TemporaryDirectory() as out:
+            subprocess.run([os.environ["SCANMATCH_CLI"], "odometry", "sim:dynamic-outdoor-fast",
+                            "--frames", "4", "--loop-closure", "--out", out, "--quiet"],
+                           check=True)
+            with open(os.path.join(out, "summary.json")) as f:
+                summary = json.load(f)
+        self.assertEqual(summary["kind"], "odometry")
+        run_keys = ["accepted", "ms_per_frame", "thread", "wait_ms_per_frame"]
+        counts = list(scanmatch.LoopClosure3D().counts)
+        self.assertEqual(counts + run_keys, list(summary["loop_closure"]))
+        doc = scanmatch.LoopClosure3D.counts.__doc__
+        for key in counts:
+            self.assertIn(f"\n  {key}: ", doc)
+
 
 if __name__ == "__main__":
     unittest.main()

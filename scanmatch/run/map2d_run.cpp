@@ -7,12 +7,12 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "scanmatch/core/background_worker.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/mapping/loop_counts.hpp"
 #include "scanmatch/run/run_config.hpp"
 #include "scanmatch/run/run_record.hpp"
 
@@ -91,19 +91,16 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
-  summary.loop_closure = options.loop_closure;
-  summary.loop_closure_thread = options.loop_closure && options.loop_closure_thread;
-  std::optional<LoopClosure2D> loop_closure;
-  if (options.loop_closure) loop_closure.emplace(options.loop);
   struct LoopInput {
     Scan2D scan;
     Pose2 pose = Pose2::Identity();
     bool weak_fit = false;
   };
-  // Loop closure is fed in scan order; it owns `loop_closure` until finish().
-  BackgroundWorker<LoopInput> loop_worker(
-      [&](LoopInput& in) { loop_closure->add_scan(in.scan, in.pose, in.weak_fit); },
-      kLoopQueueScans, options.loop_closure && options.loop_closure_thread);
+  std::optional<LoopClosureRun<LoopClosure2D, LoopInput>> closure;
+  if (options.loop_closure)
+    closure.emplace(
+        options.loop, options.loop_closure_thread, kLoopQueueScans,
+        [](LoopClosure2D& loops, LoopInput& in) { loops.add_scan(in.scan, in.pose, in.weak_fit); });
   const Stopwatch run_time;
   // The registered scans, kept to rebuild the map from the optimized poses and to measure how
   // well revisits agree.
@@ -140,7 +137,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       }
     };
     insert(grid, summary.map_error, pose);
-    if (loop_closure) loop_worker.push({mapper.last_scan(), pose, mapper.last_stats().weak_fit});
+    if (closure) closure->push({mapper.last_scan(), pose, mapper.last_stats().weak_fit});
     Scan2D kept = mapper.last_scan();
     kept.misses = scan.misses;
     kept.times.clear();
@@ -157,10 +154,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     progress.update(i + 1);
   }
   progress.finish();
-  if (loop_closure) {
-    loop_worker.finish();
-    loop_closure->finish();
-  }
+  if (closure) closure->finish();
   summary.scans = estimate.size();
   if (summary.scans > 0)
     summary.wall_ms_per_scan = run_time.ms() / static_cast<double>(summary.scans);
@@ -173,13 +167,9 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   OccupancyGrid optimized_grid(options.grid);
   std::string optimized_map_error;
   nlohmann::ordered_json loops_json = nlohmann::ordered_json::array();
-  if (loop_closure) {
-    optimized = loop_closure->poses();
-    summary.loops = loop_closure->counts();
-    if (summary.scans > 0) {
-      summary.loop_ms_per_scan = summary.loops.total_ms / static_cast<double>(summary.scans);
-      summary.loop_wait_ms_per_scan = loop_worker.waited_ms() / static_cast<double>(summary.scans);
-    }
+  if (closure) {
+    optimized = closure->loop_closure().poses();
+    summary.loop_closure = closure->record(summary.scans);
     Trajectory optimized_trajectory;
     for (std::size_t i = 0; i < optimized.size(); ++i) {
       optimized_trajectory.poses.push_back(to_pose3(optimized[i]));
@@ -193,8 +183,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     }
     write_trajectory_atomic(file("poses_optimized_tum.txt"), optimized_trajectory,
                             TrajectoryFormat::kTum);
-    for (const Loop2D& l : loop_closure->loops()) {
-      summary.accepted_loops += !l.outlier;
+    for (const Loop2D& l : closure->loop_closure().loops()) {
       if (l.outlier) continue;
       loops_json.push_back({{"from", l.from_scan},
                             {"to", l.to_scan},
@@ -216,7 +205,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     if (summary.scans > 10) summary.ten_steps = relative_pose_error_2d(reference, estimate, 10);
     summary.ate_odometry = absolute_trajectory_error_2d(reference, estimate);
     summary.all_pairs_odometry = all_pairs_relative_error_2d(reference, estimate);
-    if (loop_closure) {
+    if (closure) {
       summary.ate_optimized = absolute_trajectory_error_2d(reference, optimized);
       summary.all_pairs_optimized = all_pairs_relative_error_2d(reference, optimized);
     }
@@ -230,14 +219,14 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   // map.* is the best map there is: the optimized one with loop closure, else the odometry's.
   if (summary.scans > 0 && summary.map_error.empty()) {
     grid.crop_to_observed();
-    write_map(grid, file(loop_closure ? "map_odometry" : "map"));
+    write_map(grid, file(closure ? "map_odometry" : "map"));
     if (reference_written) {
       const double agreement = map_agreement(
           grid, reference_grid, 2, reference.front().inverse() * summary.ate_odometry.alignment);
-      (loop_closure ? summary.map_agreement_odometry : summary.map_agreement) = agreement;
+      (closure ? summary.map_agreement_odometry : summary.map_agreement) = agreement;
     }
   }
-  if (loop_closure && summary.scans > 0) {
+  if (closure && summary.scans > 0) {
     if (optimized_map_error.empty()) {
       optimized_grid.crop_to_observed();
       write_map(optimized_grid, file("map"));
@@ -252,7 +241,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   // Needs no reference: how far apart the walls of revisits lie.
   if (summary.scans > 0) {
     summary.consistency_odometry = revisit_consistency_2d(kept_scans, estimate);
-    if (loop_closure && optimized.size() == kept_scans.size())
+    if (closure && optimized.size() == kept_scans.size())
       summary.consistency_optimized = revisit_consistency_2d(kept_scans, optimized);
     if (input.has_reference)
       summary.consistency_reference = revisit_consistency_2d(kept_scans, reference);
@@ -315,25 +304,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     if (summary.consistency_reference.points > 0)
       j["revisit_consistency_reference"] = consistency_json(summary.consistency_reference);
   }
-  if (summary.loop_closure) {
-    const LoopClosure2DCounts& c = summary.loops;
-    j["loop_closure"] = {{"keyframes", c.keyframes},
-                         {"candidates", c.candidates},
-                         {"verified", c.verified},
-                         {"sliding", c.sliding},
-                         {"rejected_by_verification", c.rejected_by_verification},
-                         {"rejected_by_estimate", c.rejected_by_estimate},
-                         {"rejected_as_outliers", c.outliers},
-                         {"accepted", summary.accepted_loops},
-                         {"optimizations", c.optimizations},
-                         {"open_odometry_edges", c.open_odometry_edges},
-                         {"rotation_open_odometry_edges", c.rotation_open_odometry_edges},
-                         {"turned_at_open_rotation", c.turned_at_open_rotation},
-                         {"total_ms", c.total_ms},
-                         {"ms_per_scan", summary.loop_ms_per_scan},
-                         {"thread", summary.loop_closure_thread},
-                         {"wait_ms_per_scan", summary.loop_wait_ms_per_scan}};
-  }
+  if (summary.loop_closure) j["loop_closure"] = loop_closure_json(*summary.loop_closure, "scan");
   write_file_atomic(file("summary.json"), j.dump(2) + "\n");
   write_file_atomic(file("config.json"), map2d_config_to_json(options));
   return summary;

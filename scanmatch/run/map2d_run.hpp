@@ -3,6 +3,7 @@
 // `sim:PRESET`, chained scan to scan by Mapper2D, written as a run folder with an occupancy grid.
 
 #include <atomic>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "scanmatch/mapping/loop_closure2d.hpp"
 #include "scanmatch/mapping2d/grid_map.hpp"
 #include "scanmatch/mapping2d/mapper2d.hpp"
+#include "scanmatch/run/loop_closure_run.hpp"
 #include "scanmatch/sim/open_scans_2d.hpp"
 
 namespace scanmatch {
@@ -44,15 +46,12 @@ struct Map2DSummary {
   AbsoluteError2D ate_odometry, ate_optimized;
   /// The relative error over all pairs of poses (all_pairs_relative_error_2d), likewise.
   RelativeError2D all_pairs_odometry, all_pairs_optimized;
-  bool loop_closure = false, loop_closure_thread = false;
-  LoopClosure2DCounts loops;
-  std::size_t accepted_loops = 0;  ///< verified loop edges not judged outliers at the end
-  double loop_ms_per_scan = 0;     ///< loop closure's own time per scan (on its thread or inline)
+  /// With loop closure: its counts, accepted loops and times per scan (summary.json's
+  /// "loop_closure"); absent without.
+  std::optional<LoopClosureRecord<LoopClosure2DCounts>> loop_closure;
   /// The run's time per scan from the first scan until loop closure has caught up (no map
   /// writing): what loop closure adds shows as the difference to the same run without it.
   double wall_ms_per_scan = 0;
-  /// Per scan, the time the odometry waited for the loop closure thread (a full queue, the end).
-  double loop_wait_ms_per_scan = 0;
   /// Share of the map's occupied cells within two cells of an occupied cell of map_reference
   /// (negative: not computed; needs reference_map), for map.* and (with loop closure) the
   /// odometry's map.

@@ -7,7 +7,6 @@
 #include <optional>
 
 #include "scanmatch/config/config_io.hpp"
-#include "scanmatch/core/background_worker.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
 #include "scanmatch/core/stopwatch.hpp"
@@ -18,6 +17,7 @@
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/mapping/loop_counts.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/health.hpp"
 #include "scanmatch/odometry/spin_times.hpp"
@@ -211,27 +211,24 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   const std::size_t total =
       options.max_frames > 0 ? std::min(options.max_frames, source.size()) : source.size();
   PointMap map(options.map_voxel_size);
-  summary.loop_closure = options.loop_closure;
-  summary.loop_closure_thread = options.loop_closure && options.loop_closure_thread;
-  std::optional<LoopClosure3D> loop_closure;
-  if (options.loop_closure) loop_closure.emplace(options.loop);
   KeyframeClouds keyframe_clouds(options.map_voxel_size);
   struct LoopInput {
     PointCloud points;  ///< the registered frame's positions (loop closure uses no other field)
     Pose registered = Pose::Identity();
     bool to_map = false;  ///< the points also go into keyframe_clouds
   };
-  // Fed in frame order; it owns `loop_closure` and `keyframe_clouds` until finish().
-  BackgroundWorker<LoopInput> loop_worker(
-      [&](LoopInput& in) {
-        loop_closure->add_frame(in.points, in.registered);
-        if (in.to_map) {
-          const std::size_t index = loop_closure->frames() - 1;
-          keyframe_clouds.add(loop_closure->keyframe_of(index), in.points,
-                              loop_closure->offset_in_keyframe(index));
-        }
-      },
-      kLoopQueueFrames, options.loop_closure && options.loop_closure_thread);
+  // Fed in frame order; it owns the loop closure and `keyframe_clouds` until finish().
+  std::optional<LoopClosureRun<LoopClosure3D, LoopInput>> closure;
+  if (options.loop_closure)
+    closure.emplace(options.loop, options.loop_closure_thread, kLoopQueueFrames,
+                    [&](LoopClosure3D& loops, LoopInput& in) {
+                      loops.add_frame(in.points, in.registered);
+                      if (in.to_map) {
+                        const std::size_t index = loops.frames() - 1;
+                        keyframe_clouds.add(loops.keyframe_of(index), in.points,
+                                            loops.offset_in_keyframe(index));
+                      }
+                    });
   // Per frame, its reported pose in the frame of the pose its points were registered at (the
   // pipeline reports the frame start, registers at mid-frame): the loop-closed reported pose is
   // the loop-closed registration pose followed by it.
@@ -252,7 +249,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       if (options.map_export_radius > 0.0 && index % 50 == 0)
         map.keep_within(reported.translation(), options.map_export_radius);
     }
-    if (loop_closure) {
+    if (closure) {
       // A bridged frame (or a method that keeps no points) adds its pose only.
       LoopInput in;
       in.registered = points != nullptr ? world_from_frame : reported;
@@ -260,7 +257,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       if (points != nullptr) in.points.points = points->points;
       in.to_map = points != nullptr && options.write_map;
       reported_from_registered.push_back(in.registered.inverse() * reported);
-      loop_worker.push(std::move(in));
+      closure->push(std::move(in));
     }
   };
   const auto hand_out_unsettled = [&] {
@@ -332,10 +329,10 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     // A bridged frame has no registered points of its own (an empty frame leaves the previous
     // one in last_frame()); it would only add a copy or a guess to the map.
     Pose registration_from_frame = Pose::Identity();
-    const PointCloud* map_frame = (options.write_map || loop_closure) && !s.bridged
+    const PointCloud* map_frame = (options.write_map || closure) && !s.bridged
                                       ? odometry->last_map_frame(registration_from_frame)
                                       : nullptr;
-    if (options.write_map || loop_closure) {
+    if (options.write_map || closure) {
       if (summary.frames + 1 < odometry->world_settles_after()) {
         Unsettled u{std::nullopt, registration_from_frame, summary.frames};
         if (map_frame != nullptr) u.points = *map_frame;
@@ -352,26 +349,18 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
   settle_poses();  // a run shorter than the settling
   if (write) write_poses_until(summary.poses.size());
   hand_out_unsettled();
-  if (loop_closure) {
-    loop_worker.finish();  // also after an interruption: the queued frames are worked
-    loop_closure->finish();
-  }
+  if (closure) closure->finish();  // also after an interruption: the queued frames are worked
   if (summary.frames > 0)
     summary.wall_ms_per_frame = run_time.ms() / static_cast<double>(summary.frames);
   summary.stages = stage_statistics(summary.stats);
   summary.frames_per_second = pipeline_ms > 0.0 ? 1000.0 * summary.frames / pipeline_ms : 0.0;
   evaluate(truth, summary);
-  if (loop_closure) {
-    summary.loops = loop_closure->counts();
-    for (std::size_t i = 0; i < loop_closure->frames(); ++i)
+  if (closure) {
+    const LoopClosure3D& loops = closure->loop_closure();
+    summary.loop_closure = closure->record(summary.frames);
+    for (std::size_t i = 0; i < loops.frames(); ++i)
       summary.optimized_poses.push_back(
-          orthonormalized(loop_closure->pose(i) * reported_from_registered[i]));
-    for (const Loop3D& l : loop_closure->loops()) summary.accepted_loops += !l.outlier;
-    if (summary.frames > 0) {
-      summary.loop_ms_per_frame = summary.loops.total_ms / static_cast<double>(summary.frames);
-      summary.loop_wait_ms_per_frame =
-          loop_worker.waited_ms() / static_cast<double>(summary.frames);
-    }
+          orthonormalized(loops.pose(i) * reported_from_registered[i]));
     if (!summary.ground_truth.empty())
       summary.ate_optimized = compute_ate(
           summary.ground_truth,
@@ -385,26 +374,26 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       if (options.map_export_radius > 0.0 && !summary.poses.empty())
         map.keep_within(summary.poses.back().translation(), options.map_export_radius);
       // map.* is the best map there is: the loop-closed one with loop closure.
-      write_cloud(dir + (loop_closure ? "/map_odometry." : "/map.") + options.map_format,
-                  map.cloud());
-      if (loop_closure) {
+      write_cloud(dir + (closure ? "/map_odometry." : "/map.") + options.map_format, map.cloud());
+      if (closure) {
         PointMap optimized_map(options.map_voxel_size);
-        keyframe_clouds.add_to(optimized_map,
-                               [&](std::size_t k) { return loop_closure->graph().pose(k); });
+        keyframe_clouds.add_to(
+            optimized_map, [&](std::size_t k) { return closure->loop_closure().graph().pose(k); });
         if (options.map_export_radius > 0.0 && !summary.optimized_poses.empty())
           optimized_map.keep_within(summary.optimized_poses.back().translation(),
                                     options.map_export_radius);
         write_cloud(dir + "/map." + options.map_format, optimized_map.cloud());
       }
     }
-    if (loop_closure) {
+    if (closure) {
       Trajectory optimized;
       optimized.poses = summary.optimized_poses;
       optimized.timestamps = summary.timestamps;
       write_trajectory_atomic(dir + "/poses_optimized.txt", optimized, TrajectoryFormat::kKitti);
       write_trajectory_atomic(dir + "/poses_optimized_tum.txt", optimized, TrajectoryFormat::kTum);
-      write_file_atomic(dir + "/loops.json",
-                        loops_json(loop_closure->loops(), reported_from_registered).dump(2) + "\n");
+      write_file_atomic(
+          dir + "/loops.json",
+          loops_json(closure->loop_closure().loops(), reported_from_registered).dump(2) + "\n");
     }
     write_ground_truth(dir, truth, summary);
     nlohmann::ordered_json j = {{"kind", kOdometryRunKind},
@@ -421,24 +410,9 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
                                 {"health", health_json(summary.stats)}};
     if (summary.ate) {
       j["ate"] = ate_json(summary.ate_optimized ? *summary.ate_optimized : *summary.ate);
-      if (loop_closure) j["ate_odometry"] = ate_json(*summary.ate);
+      if (closure) j["ate_odometry"] = ate_json(*summary.ate);
     }
-    if (loop_closure) {
-      const LoopClosure3DCounts& c = summary.loops;
-      j["loop_closure"] = {{"keyframes", c.keyframes},
-                           {"candidates", c.candidates},
-                           {"verified", c.verified},
-                           {"rejected_by_verification", c.rejected_by_verification},
-                           {"rejected_by_estimate", c.rejected_by_estimate},
-                           {"ruled_out_by_estimate", c.ruled_out_by_estimate},
-                           {"rejected_as_outliers", c.outliers},
-                           {"accepted", summary.accepted_loops},
-                           {"optimizations", c.optimizations},
-                           {"total_ms", c.total_ms},
-                           {"ms_per_frame", summary.loop_ms_per_frame},
-                           {"thread", summary.loop_closure_thread},
-                           {"wait_ms_per_frame", summary.loop_wait_ms_per_frame}};
-    }
+    if (summary.loop_closure) j["loop_closure"] = loop_closure_json(*summary.loop_closure, "frame");
     j["options"] = nlohmann::ordered_json::parse(odometry_config_to_json(config));
     write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");
   }

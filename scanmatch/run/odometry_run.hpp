@@ -41,6 +41,7 @@
 #include "scanmatch/io/sequence.hpp"
 #include "scanmatch/mapping/loop_closure3d.hpp"
 #include "scanmatch/odometry/odometry.hpp"
+#include "scanmatch/run/loop_closure_run.hpp"
 
 namespace scanmatch {
 
@@ -86,16 +87,12 @@ struct RunSummary {
   /// ATE of `poses` against `ground_truth`, unaligned (both start at the identity, as the run
   /// does); absent without ground truth or frames.
   std::optional<AteResult> ate;
-  /// With loop closure: its counts, the loop-closed poses per frame, their ATE (like `ate`), the
-  /// accepted loops (not judged outliers at the end) and its time per frame.
-  bool loop_closure = false, loop_closure_thread = false;
-  LoopClosure3DCounts loops;
+  /// With loop closure: its counts, accepted loops (not judged outliers at the end) and times per
+  /// frame (summary.json's "loop_closure"; absent without), the loop-closed poses per frame and
+  /// their ATE (like `ate`).
+  std::optional<LoopClosureRecord<LoopClosure3DCounts>> loop_closure;
   std::vector<Pose> optimized_poses;
   std::optional<AteResult> ate_optimized;
-  std::size_t accepted_loops = 0;
-  double loop_ms_per_frame = 0.0;  ///< loop closure's own time per frame (on its thread or inline)
-  /// Per frame, the time the odometry waited for the loop closure thread (a full queue, the end).
-  double loop_wait_ms_per_frame = 0.0;
 
   /// The stage named `name` in frame_stats.hpp ("total"); throws std::out_of_range for others.
   const StageStatistics& stage(std::string_view name) const;

@@ -1,14 +1,17 @@
 #pragma once
 // What every run folder shares, 2D (map2d_run) and 3D (odometry_run): the folder, what kind of
 // run it holds (summary.json's "kind", which run_folder reads back), timing.csv with a row per
-// scan or frame from its record's description (core/record.hpp), whole files written atomically.
+// scan or frame from its record's description (core/record.hpp), summary.json's parts written
+// from descriptions (loop closure), whole files written atomically. For the runs' .cpp files.
 
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/record_csv.hpp"
 #include "scanmatch/io/trajectory.hpp"
+#include "scanmatch/run/loop_closure_run.hpp"
 
 namespace scanmatch {
 
@@ -39,5 +42,26 @@ class TimingWriter {
 /// Writes a whole trajectory atomically (tmp + rename); throws Error naming the file.
 void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
                              TrajectoryFormat format);
+
+/// Every field of a described record by its key (summary.json).
+template <typename Record>
+nlohmann::ordered_json record_json(const Record& record) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for_each_field(record, [&](const char* key, const auto& field, const char*) { j[key] = field; });
+  return j;
+}
+
+/// summary.json's "loop_closure": the counts' keys (mapping/loop_counts.hpp), then "accepted",
+/// "ms_per_<item>", "thread" and "wait_ms_per_<item>" (`item`: "scan" or "frame").
+template <typename Counts>
+nlohmann::ordered_json loop_closure_json(const LoopClosureRecord<Counts>& loops,
+                                         const std::string& item) {
+  nlohmann::ordered_json j = record_json(loops.counts);
+  j["accepted"] = loops.accepted;
+  j["ms_per_" + item] = loops.ms_per_item;
+  j["thread"] = loops.thread;
+  j["wait_ms_per_" + item] = loops.wait_ms_per_item;
+  return j;
+}
 
 }  // namespace scanmatch
