@@ -169,3 +169,19 @@ TEST_F(RunRecord, SummaryLoopClosureHasTheDescribedCountsThenTheRunsOwn) {
   EXPECT_EQ(odometry.at("keyframes").get<std::size_t>(), odometry_->loop_closure->counts.keyframes);
   EXPECT_EQ(odometry.at("thread").get<bool>(), odometry_->loop_closure->thread);
 }
+
+TEST_F(RunRecord, SummaryOptionsAreTheConfiguration) {
+  // Both runs' summary.json "options" come from the configuration's one description, as
+  // config.json (odometry's config.json adds the run's keys: map export, loop closure).
+  const nlohmann::ordered_json config = read_json(map2d_file("config.json"));
+  const nlohmann::ordered_json summary = read_json(map2d_file("summary.json"));
+  EXPECT_EQ(summary.at("options"), config);
+  EXPECT_TRUE(config.at("loop_closure").get<bool>());
+  EXPECT_EQ(summary.at("method"), config.at("mapper").at("registration").at("method"));
+  EXPECT_GT(summary.at("rotation_period_s").get<double>(), 0.0);  // sim: room-2d's laser turns
+  EXPECT_FALSE(summary.at("deskewed").get<bool>());               // deskew is off by default
+  nlohmann::ordered_json odometry = read_json(odometry_file("config.json"));
+  for (const char* run_key : {"loop_closure", "loop_closure_thread", "map_export", "loop"})
+    EXPECT_EQ(odometry.erase(run_key), 1u) << run_key;
+  EXPECT_EQ(read_json(odometry_file("summary.json")).at("options"), odometry);
+}

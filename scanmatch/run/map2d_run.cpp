@@ -246,33 +246,16 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     if (input.has_reference)
       summary.consistency_reference = revisit_consistency_2d(kept_scans, reference);
   }
-  const Registration2DOptions& r = options.mapper.registration;
+  // The options are the configuration as config.json holds it (one description:
+  // run/run_config_fields.hpp); what the input decided beside them is said apart.
+  const std::string config = map2d_config_to_json(options);
   nlohmann::ordered_json j;
   j["kind"] = kMap2DRunKind;
   j["input"] = input.description;
-  j["method"] = r.method;
-  j["options"] = {
-      {"initial_guess", options.mapper.constant_velocity ? "constant-velocity" : "identity"},
-      {"max_iterations", r.max_iterations},
-      {"tolerance", r.tolerance},
-      {"max_correspondence_distance", r.max_correspondence_distance},
-      {"coarse_rotation", r.coarse_rotation},
-      {"coarse_translation", r.coarse_translation},
-      {"subsample_projection", r.subsample_projection},
-      {"sparse_step", r.sparse_step},
-      {"sparse_line_radius", r.sparse_line_radius},
-      {"path_max_step", r.path_rules.max_step},
-      {"path_shared_rows", to_string(r.path_rules.shared)},
-      {"path_max_run", r.path_rules.max_run},
-      {"sparse_keep_fraction", r.sparse_keep_fraction},
-      {"sparse_min_pairs", r.sparse_min_pairs},
-      {"pl_line_radius", r.pl_line_radius},
-      {"search_window", r.search_window},
-      {"search_angle_deg", r.search_angle * 180 / M_PI},
-      {"deskew", options.mapper.deskew && input.rotation_period > 0.0},
-      {"rotation_period_s", input.rotation_period},
-      {"grid_resolution", options.grid.resolution},
-      {"miss_range", options.miss_range}};
+  j["rotation_period_s"] = input.rotation_period;
+  j["deskewed"] = options.mapper.deskew && input.rotation_period > 0.0;
+  j["method"] = options.mapper.registration.method;
+  j["options"] = nlohmann::ordered_json::parse(config);
   j["scans"] = summary.scans;
   j["bridged"] = summary.bridged;
   j["open_steps_from_prior"] = summary.open_steps_from_prior;
@@ -306,7 +289,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   }
   if (summary.loop_closure) j["loop_closure"] = loop_closure_json(*summary.loop_closure, "scan");
   write_file_atomic(file("summary.json"), j.dump(2) + "\n");
-  write_file_atomic(file("config.json"), map2d_config_to_json(options));
+  write_file_atomic(file("config.json"), config);
   return summary;
 }
 

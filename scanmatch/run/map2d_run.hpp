@@ -66,7 +66,8 @@ struct Map2DSummary {
 
 /// Writes RUNDIR/poses_tum.txt and timing.csv (flushed per scan: index, timestamp and the fields
 /// of Scan2DStats' description, mapping2d/scan2d_stats.hpp), poses_reference_tum.txt,
-/// summary.json ("kind": "map2d"), config.json (the options, for `map2d --config`) and
+/// summary.json ("kind": "map2d"; "options" as config.json), config.json (the options, for
+/// `map2d --config`) and
 /// map.{pgm,yaml,png}
 /// (atomically); with loop_closure also poses_optimized_tum.txt, loops.json and
 /// map_odometry.{pgm,yaml,png}.
