@@ -12,20 +12,28 @@
 
 namespace scanmatch {
 
+namespace loop_counts_detail {
+// The counts both loop closures keep (members of the same names).
 template <typename Counts, typename Visitor>
-requires std::same_as<std::remove_const_t<Counts>, LoopClosure2DCounts>
-void describe(Counts& c, Visitor& v) {
+void describe_shared(Counts& c, Visitor& v) {
   v("keyframes", c.keyframes, "keyframes: nodes of the pose graph");
   v("candidates", c.candidates, "candidate pairs proposed (after merging both sources)");
-  v("verified", c.verified, "candidates that passed the geometric check (loop edges added)");
-  v("sliding", c.sliding, "of those, accepted as sliding (they hold nothing along one direction)");
-  v("rejected_by_verification", c.rejected_by_verification,
-    "candidates the geometric check rejected");
+  v("verified", c.verified, "candidates that passed verification (loop edges added)");
+  v("rejected_by_verification", c.rejected_by_verification, "candidates verification rejected");
   v("rejected_by_estimate", c.rejected_by_estimate,
     "verified but too far from the current estimate (max_correction): not added");
   v("rejected_as_outliers", c.outliers,
     "loop edges the graph judged outliers at its last optimization");
   v("optimizations", c.optimizations, "pose-graph optimizations");
+}
+}  // namespace loop_counts_detail
+
+template <typename Counts, typename Visitor>
+requires std::same_as<std::remove_const_t<Counts>, LoopClosure2DCounts>
+void describe(Counts& c, Visitor& v) {
+  loop_counts_detail::describe_shared(c, v);
+  v("sliding", c.sliding,
+    "verified loops accepted as sliding (they hold nothing along one direction)");
   v("open_odometry_edges", c.open_odometry_edges,
     "odometry edges whose step the scans leave open (open_step_spread)");
   v("rotation_open_odometry_edges", c.rotation_open_odometry_edges,
@@ -39,18 +47,9 @@ void describe(Counts& c, Visitor& v) {
 template <typename Counts, typename Visitor>
 requires std::same_as<std::remove_const_t<Counts>, LoopClosure3DCounts>
 void describe(Counts& c, Visitor& v) {
-  v("keyframes", c.keyframes, "keyframes: nodes of the pose graph");
-  v("candidates", c.candidates, "candidate pairs proposed (after merging both sources)");
-  v("verified", c.verified, "candidates that passed every check (loop edges added)");
-  v("rejected_by_verification", c.rejected_by_verification,
-    "candidates the geometric verification rejected");
-  v("rejected_by_estimate", c.rejected_by_estimate,
-    "verified but too far from the current estimate (max_correction): not added");
+  loop_counts_detail::describe_shared(c, v);
   v("ruled_out_by_estimate", c.ruled_out_by_estimate,
     "place-database matches ruled out before verification (registration_reach); not candidates");
-  v("rejected_as_outliers", c.outliers,
-    "loop edges the graph judged outliers at its last optimization");
-  v("optimizations", c.optimizations, "pose-graph optimizations");
   v("total_ms", c.total_ms, "wall time spent in add_frame() and finish(), ms");
 }
 

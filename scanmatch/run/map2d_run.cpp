@@ -197,7 +197,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       if (l.sliding)
         loops_json.back()["slide_direction"] = {l.slide_direction.x(), l.slide_direction.y()};
     }
-    write_file_atomic(file("loops.json"), loops_json.dump(2) + "\n");
+    write_json_atomic(file("loops.json"), loops_json);
   }
   if (input.has_reference && !reference_trajectory.poses.empty()) {
     write_trajectory(file("poses_reference_tum.txt"), reference_trajectory, TrajectoryFormat::kTum);
@@ -288,7 +288,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       j["revisit_consistency_reference"] = consistency_json(summary.consistency_reference);
   }
   if (summary.loop_closure) j["loop_closure"] = loop_closure_json(*summary.loop_closure, "scan");
-  write_file_atomic(file("summary.json"), j.dump(2) + "\n");
+  write_json_atomic(file("summary.json"), j);
   write_file_atomic(file("config.json"), config);
   return summary;
 }

@@ -391,9 +391,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       optimized.timestamps = summary.timestamps;
       write_trajectory_atomic(dir + "/poses_optimized.txt", optimized, TrajectoryFormat::kKitti);
       write_trajectory_atomic(dir + "/poses_optimized_tum.txt", optimized, TrajectoryFormat::kTum);
-      write_file_atomic(
-          dir + "/loops.json",
-          loops_json(closure->loop_closure().loops(), reported_from_registered).dump(2) + "\n");
+      write_json_atomic(dir + "/loops.json",
+                        loops_json(closure->loop_closure().loops(), reported_from_registered));
     }
     write_ground_truth(dir, truth, summary);
     nlohmann::ordered_json j = {{"kind", kOdometryRunKind},
@@ -414,7 +413,7 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
     }
     if (summary.loop_closure) j["loop_closure"] = loop_closure_json(*summary.loop_closure, "frame");
     j["options"] = nlohmann::ordered_json::parse(odometry_config_to_json(config));
-    write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");
+    write_json_atomic(dir + "/summary.json", j);
   }
   if (!summary.error.empty()) throw Error(summary.error);
   return summary;

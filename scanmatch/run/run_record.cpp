@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/io/file_util.hpp"
 
 namespace scanmatch {
 
@@ -19,6 +20,10 @@ void write_trajectory_atomic(const std::string& path, const Trajectory& trajecto
   std::error_code ec;
   std::filesystem::rename(path + ".tmp", path, ec);
   if (ec) fail(path, "cannot replace the file: " + ec.message());
+}
+
+void write_json_atomic(const std::string& path, const nlohmann::ordered_json& j) {
+  write_file_atomic(path, j.dump(2) + "\n");
 }
 
 }  // namespace scanmatch

@@ -43,6 +43,9 @@ class TimingWriter {
 void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
                              TrajectoryFormat format);
 
+/// Writes `j` (indented by 2, a final newline) atomically: summary.json, loops.json.
+void write_json_atomic(const std::string& path, const nlohmann::ordered_json& j);
+
 /// Every field of a described record by its key (summary.json).
 template <typename Record>
 nlohmann::ordered_json record_json(const Record& record) {
