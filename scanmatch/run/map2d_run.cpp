@@ -1,8 +1,5 @@
 #include "scanmatch/run/map2d_run.hpp"
 
-#include <fmt/format.h>
-
-#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
