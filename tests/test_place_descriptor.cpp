@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/features/place_database.hpp"
 #include "scanmatch/features/place_descriptor.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/sim/motion.hpp"

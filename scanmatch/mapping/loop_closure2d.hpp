@@ -5,7 +5,7 @@
 // then the graph is optimized.
 //
 // Candidates come from two sources (their union): earlier keyframes within `proximity_radius` of
-// the new one in the current (optimized) estimate, and the place database (place_descriptor.hpp),
+// the new one in the current (optimized) estimate, and the place database (place_database.hpp),
 // both skipping the newest `skip_recent` keyframes. 2D descriptors tell similar rooms apart
 // poorly, so verification does the real work: a correlative search (correlative_search.hpp)
 // around the relative pose the candidate implies, the registration method from its result, and
@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "scanmatch/core/scan2d.hpp"
-#include "scanmatch/features/place_descriptor.hpp"
+#include "scanmatch/features/place_database.hpp"
 #include "scanmatch/mapping/keyframe_graph.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
 

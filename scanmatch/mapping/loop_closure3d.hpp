@@ -9,7 +9,7 @@
 // Livox Avia sees 70 degrees) still give enough structure, while memory stays bounded by the voxel.
 //
 // Candidates come from two sources (their union): earlier keyframes within `proximity_radius` of
-// the new one in the current (optimized) estimate, and the place database (place_descriptor.hpp),
+// the new one in the current (optimized) estimate, and the place database (place_database.hpp),
 // both skipping the newest `skip_recent` keyframes. Verification needs no prior: it starts from
 // the relative pose the estimate implies (proximity) or from the descriptor's yaw (database), runs
 // a coarse NDT registration then a fine GICP one (registration/methods.hpp), and accepts when both
@@ -26,7 +26,7 @@
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/core/se3.hpp"
-#include "scanmatch/features/place_descriptor.hpp"
+#include "scanmatch/features/place_database.hpp"
 #include "scanmatch/mapping/keyframe_graph.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
 
