@@ -7,112 +7,21 @@
 // Candidates come from two sources (their union): earlier keyframes within `proximity_radius` of
 // the new one in the current (optimized) estimate, and the place database (place_database.hpp),
 // both skipping the newest `skip_recent` keyframes. 2D descriptors tell similar rooms apart
-// poorly, so verification does the real work: a correlative search (correlative_search.hpp)
-// around the relative pose the candidate implies, the registration method from its result, and
-// then the share of the keyframe's points that land within `pair_distance` of a candidate point
-// must be high and their mean distance small. The graph's robust kernel and chi-square test
-// (PoseGraphConfig) catch what still slips through.
+// poorly, so verification (loop_verification2d.hpp) does the real work, and a verified loop must
+// also agree with the estimate. The graph's robust kernel and chi-square test (PoseGraphConfig)
+// catch what still slips through. This file holds the orchestration: keyframes, odometry edges,
+// when to search and when to optimize.
 
 #include <cstddef>
-#include <optional>
-#include <string>
 #include <vector>
 
 #include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/features/place_database.hpp"
 #include "scanmatch/mapping/keyframe_graph.hpp"
+#include "scanmatch/mapping/loop_verification2d.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
 
 namespace scanmatch {
-
-struct LoopVerification2DOptions {
-  std::string method = "pl-icp";  ///< registration_2d_methods() name of the fine stage
-  /// Correlative search around the candidate's implied relative pose: +- m in x and y, +- rad.
-  double search_window = 2.0;
-  double search_angle = 30.0 * M_PI / 180;
-  /// m; 0.1 found the same loops on the CARMEN logs as 0.05, 3.6x faster (the fine stage refines).
-  double search_resolution = 0.1;
-  /// The search gives up (rejects) where no pose scores this share of its best possible
-  /// (correlative_match): most candidates show another place, and ending their search early
-  /// halves loop closure's time. Accepted loops on the CARMEN logs scored 0.39 to 1 (5 % below
-  /// 0.54 to 0.60); 0: every candidate is searched through.
-  double min_search_score = 0.5;
-  double max_correspondence_distance = 0.3;  ///< m, of the fine stage
-  /// A current point is paired when a candidate point lies within this distance after the
-  /// registration, m.
-  double pair_distance = 0.1;
-  /// Accepted only when at least this share of the current points is paired (repeated structure
-  /// aligns partly; the same place aligns nearly everywhere the views overlap) ...
-  double min_paired_fraction = 0.65;
-  /// ... and the paired points' mean distance is below this, m. Both are checked both ways
-  /// (current onto candidate and back), so a small scan inside a larger one does not pass.
-  double max_error = 0.04;
-  /// Negative evidence: a point of one scan that lies more than `free_margin` (m) in front of
-  /// what the other scan saw along the same bearing sits in space the other saw empty. Different
-  /// places that share a few walls put many points there; more than this share (either way)
-  /// rejects.
-  double free_margin = 0.3;
-  double max_free_violations = 0.05;
-  /// Degeneracy: the paired points' surface normals (from beam neighbours) must constrain every
-  /// direction. The smaller eigenvalue of their mean n n^T (eigenvalues sum to 1) must reach this;
-  /// a corridor's two walls give ~0 and slide along it to wherever the search window allows.
-  double min_constraint = 0.1;
-  std::size_t min_points = 40;  ///< each scan needs this many points to be verified at all
-  /// Rejected when the current scan, slid 1 to 3 m along the match's least determined direction,
-  /// keeps more than this share of its paired points (an ambiguous place: a corridor with doors at
-  /// even spacing). 0: not checked.
-  double max_shifted_fraction = 0.8;
-  /// A match that fits (paired share, error, free space) but leaves one translation direction
-  /// open (a weak constraint, or the shift test above) is accepted as sliding: its loop edge holds
-  /// the heading and the translation across that direction, and along it only a share of what
-  /// the match found (LoopClosure2DOptions::sliding_information_kept). A corridor revisited holds
-  /// little else, and without such edges a whole traversal can sit 0.2 m across from the
-  /// walls it saw before (ACES's diagonal corridor, scans 264-278). false: rejected instead.
-  bool accept_sliding = true;
-};
-
-/// The result of verifying one candidate: `transform` maps current points into the candidate's
-/// frame (the loop edge's measurement T_candidate^-1 T_current).
-struct LoopVerification2D {
-  bool accepted = false;
-  Pose2 transform = Pose2::Identity();
-  double paired_fraction = 0.0;
-  double error = 0.0;            ///< m, mean distance of the paired points
-  double free_violations = 0.0;  ///< share of points in the other scan's free space (worst way)
-  double constraint = 0.0;       ///< the weaker direction's share of the normals (worst way)
-  double search_score = 0.0;     ///< the correlative search's best score (share of its best)
-  /// Gauss-Newton Hessian of the current scan's paired point-to-line distances at `transform`, in
-  /// (x, y, theta) of the current scan's frame (unscaled: the information's shape).
-  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
-  /// The largest share of the paired points kept when slid along the weak direction (when checked).
-  double shifted_fraction = 0.0;
-  /// Accepted as sliding (accept_sliding): the translation along `slide_direction` (a unit vector
-  /// in the current scan's frame, the first fit's weakest translation) is undetermined. The checks
-  /// and the Hessian above are then those at the anchored fit, but for paired_fraction: the first
-  /// fit's.
-  bool sliding = false;
-  Eigen::Vector2d slide_direction = Eigen::Vector2d::Zero();
-};
-
-/// A scan and the pose it was taken from, in the frame of the scan it is joined to.
-struct PosedScan2D {
-  const Scan2D* scan = nullptr;
-  Pose2 pose = Pose2::Identity();
-};
-
-/// Verifies that `current` and `candidate` show the same place, starting from `initial` (current
-/// in the candidate's frame). Never throws for bad scans (too few or non-finite points): rejects.
-/// With `candidate_neighbours` (scans taken near the candidate, posed in its frame) the current
-/// scan is registered onto and paired against the candidate joined by them, whose wider view a
-/// 180-degree scan revisiting a place from elsewhere overlaps; the way back (candidate onto
-/// current) then checks only the error and the free space, not the paired share. The free space
-/// is what each of those scans saw from where it was taken. A sliding match (accept_sliding) is
-/// fitted again from `anchor`'s position along its open direction (default: `initial`'s), and
-/// must fit there too.
-LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
-                                  const Pose2& initial, const LoopVerification2DOptions& options,
-                                  const std::vector<PosedScan2D>& candidate_neighbours = {},
-                                  const std::optional<Pose2>& anchor = std::nullopt);
 
 struct LoopClosure2DOptions {
   /// A new keyframe once the odometry has moved this far from the last one (m or rad). Every
