@@ -1,77 +1,16 @@
 #include "scanmatch/mapping/loop_closure3d.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
-#include "scanmatch/geometry/covariance.hpp"
-#include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
 namespace {
-
-constexpr int kNormalNeighbours = 10;
-
-bool finite_cloud(const PointCloud& cloud) {
-  return std::all_of(cloud.points.begin(), cloud.points.end(),
-                     [](const Point& p) { return p.allFinite(); });
-}
-
-struct OverlapCheck {
-  double overlap = 0.0, error = 0.0;
-  Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();  ///< sum of n n^T over the paired points
-};
-
-// `from`'s points moved by `T` against `onto` (its k-d tree and normals). A point pairs with its
-// nearest neighbour within `pair_distance` and counts when it lies within `plane_distance` of
-// that neighbour's tangent plane: downsampled clouds sample a surface at different spots, so the
-// plane distance, not the point distance, shows whether they agree.
-OverlapCheck check_overlap(const PointCloud& from, const PointCloud& onto, const KdTree& onto_tree,
-                           const std::vector<Eigen::Vector3d>& onto_normals, const Pose& T,
-                           double pair_distance, double plane_distance) {
-  OverlapCheck c;
-  const auto max_squared = static_cast<float>(pair_distance * pair_distance);
-  const Eigen::Matrix3f R = T.linear().cast<float>();
-  const Eigen::Vector3f t = T.translation().cast<float>();
-  std::size_t agreeing = 0;
-  double sum = 0.0;
-  for (const Point& p : from.points) {
-    const Point q = R * p + t;
-    std::size_t index = 0;
-    float squared = 0.0f;
-    if (!onto_tree.nearest(q, max_squared, index, squared)) continue;
-    const Eigen::Vector3d& n = onto_normals[index];
-    const double distance = std::abs(n.dot((q - onto.points[index]).cast<double>()));
-    if (distance > plane_distance) continue;
-    ++agreeing;
-    sum += distance;
-    c.normals += n * n.transpose();
-  }
-  c.overlap =
-      static_cast<double>(agreeing) / static_cast<double>(std::max<std::size_t>(from.size(), 1));
-  c.error = agreeing > 0 ? sum / static_cast<double>(agreeing) : 1e9;
-  return c;
-}
-
-// The smallest eigenvalue of the normals' scatter, normalised to trace 1: the share the weakest
-// translation direction gets (1/3 when the surfaces face every way, 0 in a tunnel).
-double weakest_direction(const Eigen::Matrix3d& normals) {
-  const double trace = normals.trace();
-  if (!(trace > 0.0)) return 0.0;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normals / trace);
-  return eigen.eigenvalues()(0);  // ascending
-}
-
-// The solver's tangent order is [rotation; translation]; the pose graph's is the reverse.
-Matrix6d to_graph_order(const Matrix6d& H) {
-  Eigen::PermutationMatrix<6> swap;
-  swap.indices() << 3, 4, 5, 0, 1, 2;
-  return swap * H * swap.transpose();
-}
 
 PoseGraph3D::Information diagonal_information(double sigma_translation, double sigma_rotation) {
   Vector6d d;
@@ -94,56 +33,6 @@ PointCloud clean_points(const PointCloud& cloud, double voxel) {
 }
 
 }  // namespace
-
-LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& candidate,
-                                  const Pose& initial, const LoopVerification3DOptions& options) {
-  LoopVerification3D out;
-  out.transform = initial;
-  const std::size_t min_points = std::max<std::size_t>(options.min_points, kNormalNeighbours + 1);
-  if (current.size() < min_points || candidate.size() < min_points || !finite_cloud(current) ||
-      !finite_cloud(candidate) || !is_valid_pose(initial.matrix(), 1e-6))
-    return out;
-  RegistrationOptions coarse;
-  coarse.method = options.coarse_method;
-  coarse.voxel_resolution = options.coarse_resolution;
-  coarse.solver.max_iterations = options.max_iterations;
-  RegistrationOptions fine;
-  fine.method = options.fine_method;
-  fine.max_correspondence_distance = options.fine_max_correspondence_distance;
-  fine.solver.max_iterations = options.max_iterations;
-  RegistrationResult result;
-  try {
-    const Pose start = register_clouds(current, candidate, coarse, initial).transform;
-    if (!is_valid_pose(start.matrix(), 1e-6)) return out;
-    result = register_clouds(current, candidate, fine, start);
-  } catch (const Error&) {
-    return out;  // too few usable points for a method: not verifiable, so not a loop
-  }
-  if (!is_valid_pose(result.transform.matrix(), 1e-6)) return out;
-  out.transform = result.transform;
-  if (result.information.allFinite()) out.hessian = to_graph_order(result.information);
-
-  const KdTree current_tree(current.points), candidate_tree(candidate.points);
-  const std::vector<Eigen::Vector3d> current_normals =
-      estimate_normals(current, current_tree, kNormalNeighbours);
-  const std::vector<Eigen::Vector3d> candidate_normals =
-      estimate_normals(candidate, candidate_tree, kNormalNeighbours);
-  const OverlapCheck forward =
-      check_overlap(current, candidate, candidate_tree, candidate_normals, out.transform,
-                    options.pair_distance, options.plane_distance);
-  OverlapCheck backward =
-      check_overlap(candidate, current, current_tree, current_normals, out.transform.inverse(),
-                    options.pair_distance, options.plane_distance);
-  // Both in the candidate's frame, so that the two ways' normals add up.
-  const Eigen::Matrix3d R = out.transform.linear();
-  backward.normals = R * backward.normals * R.transpose();
-  out.overlap = std::min(forward.overlap, backward.overlap);
-  out.error = std::max(forward.error, backward.error);
-  out.constraint = weakest_direction(forward.normals + backward.normals);
-  out.accepted = out.overlap >= options.min_overlap && out.error <= options.max_error &&
-                 out.constraint >= options.min_constraint;
-  return out;
-}
 
 LoopClosure3D::LoopClosure3D(const LoopClosure3DOptions& options)
     : options_(options), graph_(options.graph), frame_voxel_(options.submap_voxel) {
