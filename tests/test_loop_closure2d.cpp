@@ -12,7 +12,9 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics2d.hpp"
+#include "scanmatch/mapping/edge_information.hpp"
 #include "scanmatch/mapping/loop_closure2d.hpp"
+#include "scanmatch/mapping/loop_verification2d.hpp"
 #include "scanmatch/mapping2d/mapper2d.hpp"
 #include "scanmatch/run/map2d_run.hpp"
 #include "scanmatch/sim/simulator.hpp"

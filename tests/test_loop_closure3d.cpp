@@ -20,6 +20,7 @@
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/mapping/loop_closure3d.hpp"
+#include "scanmatch/mapping/loop_verification3d.hpp"
 #include "scanmatch/run/odometry_run.hpp"
 #include "scanmatch/sim/scene.hpp"
 #include "scanmatch/sim/sensor.hpp"

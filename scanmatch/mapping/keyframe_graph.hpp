@@ -4,56 +4,13 @@
 // (so a frame's optimized pose follows its keyframe's), and the accepted loops with the outlier
 // flags of the last optimize(). The owner adds the keyframe nodes and their odometry edges.
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <vector>
 
 #include "scanmatch/mapping/pose_graph.hpp"
 
 namespace scanmatch {
-
-/// A loop edge's information from its registration's Gauss-Newton `hessian` (translation first,
-/// then rotation; 3x3 in 2D, 6x6 in 3D): the shape kept, scaled so that the best translation
-/// direction has `sigma_translation`; the rotation block's best direction capped at
-/// `sigma_rotation` (at that scale it claims the points' lever arm worth of certainty, more than
-/// submaps built from odometry poses hold); eigenvalues floored at 1e-6 of the largest so that the
-/// graph gets a positive definite matrix even where the geometry leaves a direction free (along a
-/// corridor). `fallback` where the Hessian is not usable.
-template <int Dim>
-typename PoseGraph<Dim>::Information shaped_loop_information(
-    const typename PoseGraph<Dim>::Information& hessian, double sigma_translation,
-    double sigma_rotation, const typename PoseGraph<Dim>::Information& fallback) {
-  using Matrix = typename PoseGraph<Dim>::Information;
-  constexpr int kDof = PoseGraph<Dim>::kDof, kRotation = kDof - Dim;
-  using Vector = Eigen::Matrix<double, kDof, 1>;
-  if (!hessian.allFinite()) return fallback;
-  const Matrix H = 0.5 * (hessian + hessian.transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Dim, Dim>> translation(
-      H.template topLeftCorner<Dim, Dim>());
-  const double strongest = translation.eigenvalues()(Dim - 1);
-  if (!(strongest > 0.0)) return fallback;
-  Matrix scaled = H / (strongest * sigma_translation * sigma_translation);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kRotation, kRotation>> rotation(
-      scaled.template bottomRightCorner<kRotation, kRotation>());
-  const double rotation_cap = 1.0 / (sigma_rotation * sigma_rotation);
-  if (rotation.eigenvalues()(kRotation - 1) > rotation_cap) {
-    // Rows and columns scaled alike, so the matrix stays positive semi-definite.
-    Vector d = Vector::Ones();
-    d.template tail<kRotation>().setConstant(
-        std::sqrt(rotation_cap / rotation.eigenvalues()(kRotation - 1)));
-    scaled = d.asDiagonal() * scaled * d.asDiagonal();
-  }
-  const Eigen::SelfAdjointEigenSolver<Matrix> eigen(scaled);
-  if (eigen.info() != Eigen::Success) return fallback;
-  const double floor = 1e-6 * eigen.eigenvalues().maxCoeff();
-  const Vector values = eigen.eigenvalues().cwiseMax(floor);
-  if (!(floor > 0.0) || !values.allFinite()) return fallback;
-  const Matrix information =
-      eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
-  return 0.5 * (information + information.transpose());
-}
 
 /// `Loop` has from_keyframe, to_keyframe (graph nodes), relative (to in the frame of from) and a
 /// bool outlier.

@@ -8,6 +8,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
+#include "scanmatch/mapping/edge_information.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
@@ -18,30 +19,6 @@ namespace {
 // are given in.
 double moved_at_5m(const Pose2& change) {
   return change.translation().norm() + 5.0 * std::abs(pose2_angle(change));
-}
-
-// The information with only `kept` (a share in [0, 1]) of what it holds along the translation
-// `direction` (unit, in the residual's frame), plus a trace, 1e-6 of its largest eigenvalue, that
-// keeps it positive definite when nothing is kept.
-Eigen::Matrix3d weakened_along(const Eigen::Matrix3d& information, const Eigen::Vector2d& direction,
-                               double kept) {
-  Eigen::Vector3d u = Eigen::Vector3d::Zero();
-  u.head<2>() = direction.normalized();
-  const Eigen::Matrix3d keep = Eigen::Matrix3d::Identity() - u * u.transpose();
-  const Eigen::Matrix3d held = keep * information * keep;
-  const double largest =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(information, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .maxCoeff();
-  const Eigen::Matrix3d out =
-      held + kept * (information - held) + 1e-6 * largest * u * u.transpose();
-  return 0.5 * (out + out.transpose());
-}
-
-Eigen::Matrix3d diagonal_information(double sigma_xy, double sigma_theta) {
-  return Eigen::Vector3d(1 / (sigma_xy * sigma_xy), 1 / (sigma_xy * sigma_xy),
-                         1 / (sigma_theta * sigma_theta))
-      .asDiagonal();
 }
 
 }  // namespace
@@ -239,11 +216,9 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     loop.error = v.error;
     loop.sliding = v.sliding;
     loop.slide_direction = v.slide_direction;
-    Eigen::Matrix3d information = loop_information(v.hessian);
-    if (v.sliding)
-      information =
-          weakened_along(information, v.slide_direction, options_.sliding_information_kept);
-    graph_.add_loop(loop, information);
+    graph_.add_loop(loop, loop_information_2d(v, options_.loop_sigma_xy, options_.loop_sigma_theta,
+                                              options_.hessian_loop_information,
+                                              options_.sliding_information_kept));
   }
   return stale;
 }
@@ -261,33 +236,6 @@ bool LoopClosure2D::agrees_turned_at_open_rotation(std::size_t older, std::size_
     if ((turned - implied.translation()).norm() <= allowed) return true;
   }
   return false;
-}
-
-Eigen::Matrix3d LoopClosure2D::loop_information(const Eigen::Matrix3d& hessian) const {
-  const Eigen::Matrix3d fallback =
-      diagonal_information(options_.loop_sigma_xy, options_.loop_sigma_theta);
-  // Along a corridor a loop then holds nothing, so one that slid cannot pull the map along it.
-  if (!options_.hessian_loop_information) return fallback;
-  return shaped_loop_information<2>(hessian, options_.loop_sigma_xy, options_.loop_sigma_theta,
-                                    fallback);
-}
-
-Eigen::Matrix3d spread_odometry_information(const Eigen::Matrix2d& spread, const Pose2& measurement,
-                                            double sigma_xy, double sigma_theta, double normal) {
-  Eigen::Matrix3d information = diagonal_information(sigma_xy, sigma_theta);
-  if (!spread.allFinite()) return information;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(0.5 * (spread + spread.transpose()));
-  const Eigen::Vector2d widened =
-      (eigen.eigenvalues().array() - normal * normal).max(0.0) + sigma_xy * sigma_xy;
-  if (widened.maxCoeff() <= sigma_xy * sigma_xy) return information;
-  // The spread lies in the previous keyframe's frame, the edge's residual in the measured step's
-  // end frame (pose_graph.hpp): turned by the step's rotation, or a 40-degree turn loosens a
-  // direction 40 degrees off the open one.
-  const Eigen::Matrix2d to_residual = measurement.rotation().transpose();
-  information.topLeftCorner<2, 2>() = to_residual * eigen.eigenvectors() *
-                                      widened.cwiseInverse().asDiagonal() *
-                                      eigen.eigenvectors().transpose() * to_residual.transpose();
-  return information;
 }
 
 double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
@@ -318,7 +266,8 @@ double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
 LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
     const Scan2D& previous, const Scan2D& current, const Pose2& measurement) const {
   OdometryInformation out;
-  out.information = diagonal_information(options_.odometry_sigma_xy, options_.odometry_sigma_theta);
+  out.information =
+      diagonal_information<2>(options_.odometry_sigma_xy, options_.odometry_sigma_theta);
   if (!(options_.odometry_spread_window > 0.0)) return out;
   // A small angle window: the rotation is what scans determine best; it lets each translation
   // find its fit where the step's rotation is a little off.

@@ -163,14 +163,6 @@ struct LoopClosure2DCounts {
   double total_ms = 0.0;  ///< wall time spent in add_scan() and finish()
 };
 
-/// The information of an odometry edge (x, y, theta in the pose graph's residual frame) whose
-/// step measures `measurement` (current in the previous keyframe's frame): standard deviations
-/// `sigma_xy` and `sigma_theta`, the translation widened by the part of the fitting translations'
-/// `spread` (their second moment about the step, m^2, in the previous keyframe's frame:
-/// CorrelativeSpread::second_moment) beyond `normal` (m) in each of its directions.
-Eigen::Matrix3d spread_odometry_information(const Eigen::Matrix2d& spread, const Pose2& measurement,
-                                            double sigma_xy, double sigma_theta, double normal);
-
 /// How well the best rotation 10-90 degrees off the step `measurement` (current in the previous
 /// scan's frame) fits, against the step's own rotation: the correlative scores (translations
 /// within +- `window` m) of the far rotations' best over the best within 4 degrees of the step.
@@ -219,9 +211,6 @@ class LoopClosure2D {
   /// Verifies `keyframe`'s candidates and adds the accepted loop edges (skipping pairs already
   /// joined); true when one disagrees enough with the estimate to call for an optimization.
   bool search_loops(std::size_t keyframe);
-  /// A loop edge's information: the verification's Hessian scaled to loop_sigma_xy in its best
-  /// direction, the rotation capped at loop_sigma_theta (or the diagonal of both sigmas).
-  Eigen::Matrix3d loop_information(const Eigen::Matrix3d& hessian) const;
   /// Whether a loop putting keyframe `newer` at `implied` agrees with the estimate within
   /// `allowed` (m) once the keyframes after one rotation-open step between `older` and `newer`
   /// are turned about it to the loop's heading.

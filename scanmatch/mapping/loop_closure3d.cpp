@@ -7,17 +7,11 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
+#include "scanmatch/mapping/edge_information.hpp"
 #include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
 namespace {
-
-PoseGraph3D::Information diagonal_information(double sigma_translation, double sigma_rotation) {
-  Vector6d d;
-  d.head<3>().setConstant(1.0 / (sigma_translation * sigma_translation));
-  d.tail<3>().setConstant(1.0 / (sigma_rotation * sigma_rotation));
-  return d.asDiagonal();
-}
 
 // The cloud without non-finite points, downsampled (an empty cloud when even that fails, e.g. a
 // coordinate too far away for a voxel index).
@@ -82,8 +76,8 @@ bool LoopClosure3D::add_frame(const PointCloud& points, const Pose& odometry_pos
       k.path = previous.path + measurement.translation().norm();
       graph_.graph().add_node(orthonormalized(graph().pose(index - 1) * measurement));
       graph_.graph().add_edge(index - 1, index, measurement,
-                              diagonal_information(options_.odometry_sigma_translation,
-                                                   options_.odometry_sigma_rotation),
+                              diagonal_information<3>(options_.odometry_sigma_translation,
+                                                      options_.odometry_sigma_rotation),
                               EdgeKind::kOdometry);
     }
     places_.add(make_place_descriptor(k.submap, options_.descriptor));
@@ -197,7 +191,8 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
     loop.relative = orthonormalized(v.transform);
     loop.overlap = v.overlap;
     loop.error = v.error;
-    graph_.add_loop(loop, loop_information(v.hessian));
+    graph_.add_loop(loop, loop_information_3d(v.hessian, options_.loop_sigma_translation,
+                                              options_.loop_sigma_rotation));
     added = true;
   }
   if (added) {
@@ -209,14 +204,6 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
 double LoopClosure3D::correction_allowed(std::size_t keyframe, std::size_t candidate) const {
   return options_.max_correction +
          options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[candidate].path);
-}
-
-PoseGraph3D::Information LoopClosure3D::loop_information(const Matrix6d& hessian) const {
-  // A submap match's rotation block claims tens of metres of lever arm: capped (see
-  // shaped_loop_information).
-  return shaped_loop_information<3>(
-      hessian, options_.loop_sigma_translation, options_.loop_sigma_rotation,
-      diagonal_information(options_.loop_sigma_translation, options_.loop_sigma_rotation));
 }
 
 void LoopClosure3D::optimize() {

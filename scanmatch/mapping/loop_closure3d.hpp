@@ -162,7 +162,6 @@ class LoopClosure3D {
   PointCloud build_submap(const Pose& keyframe_odometry);
   void close_loops(std::size_t keyframe);
   void optimize();
-  PoseGraph3D::Information loop_information(const Matrix6d& hessian) const;
   /// The estimate gate (m) between a keyframe and an older candidate.
   double correction_allowed(std::size_t keyframe, std::size_t candidate) const;
 
