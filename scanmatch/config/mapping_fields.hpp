@@ -3,6 +3,7 @@
 // once (the protocol: fields.hpp).
 #include "scanmatch/config/fields.hpp"
 #include "scanmatch/features/place_descriptor.hpp"
+#include "scanmatch/mapping/loop_candidates.hpp"
 #include "scanmatch/mapping/loop_closure2d.hpp"
 #include "scanmatch/mapping/loop_closure3d.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
@@ -46,6 +47,19 @@ void describe(PoseGraphConfig& g, Visitor& v) {
     "Chi-square above which a 3D loop is an outlier");
   v("drop_outliers", g.drop_outliers, nullptr, "Re-solve without the outlier loops");
   v("max_iterations", g.max_iterations, nullptr, "Levenberg-Marquardt iterations per solve");
+}
+
+// Spliced flat into both loop closures' objects (not nested), where their keys always stood.
+template <typename Visitor>
+void describe(LoopCandidateOptions& o, Visitor& v) {
+  v("proximity_radius", o.proximity_radius, nullptr,
+    "Candidates within this distance in the current estimate, m");
+  v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
+    "Pose-proximity candidates per keyframe, at most");
+  v("max_descriptor_distance", o.max_descriptor_distance, nullptr,
+    "Place-database candidates below this descriptor distance");
+  v("max_descriptor_candidates", o.max_descriptor_candidates, nullptr,
+    "Place-database candidates per keyframe, at most");
 }
 
 template <typename Visitor>
@@ -124,14 +138,7 @@ void describe(LoopClosure3DOptions& o, Visitor& v) {
   v("loop_sigma_rotation", o.loop_sigma_rotation, nullptr,
     "Loop edge: the best rotation direction's standard deviation, at least, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
-  v("proximity_radius", o.proximity_radius, nullptr,
-    "Candidates within this distance in the current estimate, m");
-  v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
-    "Pose-proximity candidates per keyframe, at most");
-  v("max_descriptor_distance", o.max_descriptor_distance, nullptr,
-    "Place-database candidates below this descriptor distance");
-  v("max_descriptor_candidates", o.max_descriptor_candidates, nullptr,
-    "Place-database candidates per keyframe, at most");
+  describe(o.candidates, v);  // flat: its keys stand here in the loop closure's object
   v("descriptor_matches", o.descriptor_matches, nullptr,
     "Place-database matches looked at per keyframe");
   v("max_correction", o.max_correction, nullptr,
@@ -181,14 +188,7 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
     "loop edges' information shaped by the match's Hessian (false: diagonal sigmas)");
   v("sliding_information_kept", o.sliding_information_kept, nullptr,
     "share of a sliding loop's information kept along its open direction (0: none)");
-  v("proximity_radius", o.proximity_radius, nullptr,
-    "Candidates within this distance in the current estimate, m");
-  v("max_proximity_candidates", o.max_proximity_candidates, nullptr,
-    "Pose-proximity candidates per keyframe, at most");
-  v("max_descriptor_distance", o.max_descriptor_distance, nullptr,
-    "Place-database candidates below this descriptor distance");
-  v("max_descriptor_candidates", o.max_descriptor_candidates, nullptr,
-    "Place-database candidates per keyframe, at most");
+  describe(o.candidates, v);  // flat: its keys stand here in the loop closure's object
   v("max_correction", o.max_correction, nullptr,
     "A verified loop may move the estimate by this many m ...");
   v("max_correction_per_m", o.max_correction_per_m, nullptr,

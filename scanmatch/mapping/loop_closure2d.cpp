@@ -9,6 +9,7 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/mapping/edge_information.hpp"
+#include "scanmatch/mapping/loop_candidates.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
 
@@ -133,43 +134,12 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
 }
 
 bool LoopClosure2D::search_loops(std::size_t keyframe) {
-  if (keyframe <= options_.skip_recent) return false;
-  const std::size_t last_candidate = keyframe - options_.skip_recent;  // exclusive
+  const LoopCandidates found =
+      find_loop_candidates(keyframe, options_.skip_recent, graph(), places_, options_.candidates);
   const Pose2& here = graph().pose(keyframe);
-  // Candidates with the relative pose each implies (current keyframe in the candidate's frame).
-  std::vector<std::pair<std::size_t, Pose2>> candidates;
-  if (options_.max_proximity_candidates > 0) {
-    std::vector<std::pair<double, std::size_t>> near;
-    for (std::size_t k = 0; k < last_candidate; ++k) {
-      const double d = (graph().pose(k).translation() - here.translation()).norm();
-      if (d <= options_.proximity_radius) near.emplace_back(d, k);
-    }
-    std::sort(near.begin(), near.end());
-    // Nearest first, but not several neighbours of one visit: they would verify the same loop.
-    std::vector<std::size_t> chosen;
-    for (const auto& [d, k] : near) {
-      if (chosen.size() >= options_.max_proximity_candidates) break;
-      const bool same_visit = std::any_of(chosen.begin(), chosen.end(), [&](std::size_t c) {
-        return (c > k ? c - k : k - c) < options_.skip_recent / 2 + 1;
-      });
-      if (same_visit) continue;
-      chosen.push_back(k);
-      candidates.emplace_back(k, graph().pose(k).inverse() * here);
-    }
-  }
-  if (options_.max_descriptor_candidates > 0) {
-    const auto found = places_.query(places_.at(keyframe), options_.skip_recent + 1,
-                                     options_.max_descriptor_candidates);
-    for (const PlaceCandidate& c : found) {
-      if (c.distance > options_.max_descriptor_distance || c.index >= last_candidate) continue;
-      const bool known = std::any_of(candidates.begin(), candidates.end(),
-                                     [&](const auto& p) { return p.first == c.index; });
-      // The descriptor knows the yaw only: the translation is left to the search window.
-      if (!known) candidates.emplace_back(c.index, pose2(0.0, 0.0, c.yaw));
-    }
-  }
   bool stale = false;
-  for (const auto& [k, initial] : candidates) {
+  for (const LoopCandidate& candidate : found.candidates) {
+    const std::size_t k = candidate.keyframe;
     const bool linked = std::any_of(
         graph_.loops().begin(), graph_.loops().end(),
         [&](const Loop2D& l) { return l.from_keyframe == k && l.to_keyframe == keyframe; });
@@ -178,13 +148,15 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     std::vector<PosedScan2D> neighbours;
     if (options_.submap_keyframes > 0) {
       const std::size_t first = k > options_.submap_keyframes ? k - options_.submap_keyframes : 0;
-      const std::size_t end = std::min(k + options_.submap_keyframes + 1, last_candidate);
+      const std::size_t end = std::min(k + options_.submap_keyframes + 1, found.end);
       for (std::size_t j = first; j < end; ++j)
         if (j != k)
           neighbours.push_back(
               {&keyframes_[j].points, graph().pose(k).inverse() * graph().pose(j)});
     }
     const Pose2 estimated = graph().pose(k).inverse() * here;
+    // The descriptor knows the yaw only: the translation is left to the search window.
+    const Pose2 initial = candidate.by_descriptor ? pose2(0.0, 0.0, candidate.yaw) : estimated;
     const LoopVerification2D v =
         verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points, initial,
                        options_.verification, neighbours, estimated);

@@ -4,9 +4,9 @@
 // same place, verifies every candidate geometrically and adds the verified ones as loop edges,
 // then the graph is optimized.
 //
-// Candidates come from two sources (their union): earlier keyframes within `proximity_radius` of
-// the new one in the current (optimized) estimate, and the place database (place_database.hpp),
-// both skipping the newest `skip_recent` keyframes. 2D descriptors tell similar rooms apart
+// Candidates come from two sources (their union, loop_candidates.hpp): earlier keyframes near the
+// new one in the current (optimized) estimate, and the place database (place_database.hpp), both
+// skipping the newest `skip_recent` keyframes. 2D descriptors tell similar rooms apart
 // poorly, so verification (loop_verification2d.hpp) does the real work, and a verified loop must
 // also agree with the estimate. The graph's robust kernel and chi-square test (PoseGraphConfig)
 // catch what still slips through. This file holds the orchestration: keyframes, odometry edges,
@@ -18,6 +18,7 @@
 #include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/features/place_database.hpp"
 #include "scanmatch/mapping/keyframe_graph.hpp"
+#include "scanmatch/mapping/loop_candidates.hpp"
 #include "scanmatch/mapping/loop_verification2d.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
 
@@ -92,15 +93,13 @@ struct LoopClosure2DOptions {
   /// kept, 0.30 m with 0.3 (0.29 with 0.03); ACES 0.101 -> 0.098 m, room-2d seeds 1-5 on average
   /// 0.45 -> 0.40 m. 0: nothing (the loop holds the heading and the translation across only).
   double sliding_information_kept = 0.3;
-  /// Pose-proximity candidates: earlier keyframes within this distance (m) of the new one in the
-  /// current estimate, nearest first, at most `max_proximity_candidates` (0: none), each at least
-  /// skip_recent / 2 + 1 keyframes from the others (not two neighbours of one visit; with the
-  /// default skip_recent, 2).
-  double proximity_radius = 4.0;
-  std::size_t max_proximity_candidates = 2;
-  /// Place-database candidates below this descriptor distance, at most this many (0: none).
-  double max_descriptor_distance = 0.2;
-  std::size_t max_descriptor_candidates = 1;
+  /// Candidates (loop_candidates.hpp): earlier keyframes within 4 m in the current estimate, the 2
+  /// nearest of different visits (with the default skip_recent, 2 keyframes apart at least), and
+  /// the place database's best match below descriptor distance 0.2.
+  LoopCandidateOptions candidates{.proximity_radius = 4.0,
+                                  .max_proximity_candidates = 2,
+                                  .max_descriptor_distance = 0.2,
+                                  .max_descriptor_candidates = 1};
   /// Repeated structure (identical rooms, doors at equal spacing) verifies perfectly at the wrong
   /// place, so a verified loop must also agree with the current estimate: its translation may
   /// differ from the estimate's relative pose by at most this base (m) plus this share of the

@@ -8,6 +8,7 @@
 #include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/mapping/edge_information.hpp"
+#include "scanmatch/mapping/loop_candidates.hpp"
 #include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
@@ -118,59 +119,24 @@ PointCloud LoopClosure3D::build_submap(const Pose& keyframe_odometry) {
 }
 
 void LoopClosure3D::close_loops(std::size_t keyframe) {
-  if (keyframe <= options_.skip_recent) return;
-  const std::size_t last_candidate = keyframe - options_.skip_recent;  // exclusive
   const Pose here = graph().pose(keyframe);
-  // Candidates with the relative pose each implies (current keyframe in the candidate's frame).
-  std::vector<std::pair<std::size_t, Pose>> candidates;
-  if (options_.max_proximity_candidates > 0) {
-    std::vector<std::pair<double, std::size_t>> near;
-    for (std::size_t k = 0; k < last_candidate; ++k) {
-      const double d = (graph().pose(k).translation() - here.translation()).norm();
-      if (d <= options_.proximity_radius) near.emplace_back(d, k);
-    }
-    std::sort(near.begin(), near.end());
-    // Nearest first, but not several neighbours of one visit: they would verify the same loop.
-    std::vector<std::size_t> chosen;
-    for (const auto& [d, k] : near) {
-      if (chosen.size() >= options_.max_proximity_candidates) break;
-      const bool same_visit = std::any_of(chosen.begin(), chosen.end(), [&](std::size_t c) {
-        return (c > k ? c - k : k - c) < options_.skip_recent / 2 + 1;
-      });
-      if (same_visit) continue;
-      chosen.push_back(k);
-      candidates.emplace_back(k, orthonormalized(graph().pose(k).inverse() * here));
-    }
-  }
-  if (options_.max_descriptor_candidates > 0) {
-    // Look-alike places often match better than the true one: the best few matches are looked
-    // at, those the estimate rules out dropped, and the best remaining ones verified.
-    const auto found =
-        places_.query(places_.at(keyframe), options_.skip_recent + 1,
-                      std::max(options_.descriptor_matches, options_.max_descriptor_candidates));
-    std::size_t taken = 0;
-    for (const PlaceCandidate& c : found) {
-      if (taken >= options_.max_descriptor_candidates) break;
-      if (c.distance > options_.max_descriptor_distance || c.index >= last_candidate) continue;
-      const bool known = std::any_of(candidates.begin(), candidates.end(),
-                                     [&](const auto& p) { return p.first == c.index; });
-      if (known) continue;
-      // The descriptor knows the yaw only: the coarse registration finds the translation. A
-      // registration moves its start by a few metres at most, so a start this far from the
-      // estimate could not end within its gate (close_loops' check after verification).
-      const double distance = (graph().pose(c.index).translation() - here.translation()).norm();
-      if (distance > correction_allowed(keyframe, c.index) + options_.registration_reach) {
-        ++counts_.ruled_out_by_estimate;
-        continue;
-      }
-      candidates.emplace_back(c.index, from_xyz_rpy(0, 0, 0, 0, 0, c.yaw));
-      ++taken;
-    }
-  }
+  // Look-alike places often match better than the true one: the database's best few matches are
+  // looked at. A registration moves its start (the descriptor's, without translation) by a few
+  // metres at most, so a match this far from the estimate could not end within its gate (the
+  // check after verification, below).
+  const LoopCandidates found = find_loop_candidates(
+      keyframe, options_.skip_recent, graph(), places_, options_.candidates,
+      options_.descriptor_matches,
+      [&](std::size_t k) { return correction_allowed(keyframe, k) + options_.registration_reach; });
+  counts_.ruled_out_by_estimate += found.ruled_out;
   bool added = false;
-  for (const auto& [k, initial] : candidates) {
+  for (const LoopCandidate& candidate : found.candidates) {
+    const std::size_t k = candidate.keyframe;
     ++counts_.candidates;
     const Pose estimated = graph().pose(k).inverse() * here;
+    // The descriptor knows the yaw only: the coarse registration finds the translation.
+    const Pose initial = candidate.by_descriptor ? from_xyz_rpy(0, 0, 0, 0, 0, candidate.yaw)
+                                                 : orthonormalized(estimated);
     const double allowed = correction_allowed(keyframe, k);
     const LoopVerification3D v = verify_loop_3d(keyframes_[keyframe].submap, keyframes_[k].submap,
                                                 initial, options_.verification);

@@ -8,9 +8,9 @@
 // keyframe's frame by the odometry and voxel-downsampled, so that narrow or sparse sensors (a
 // Livox Avia sees 70 degrees) still give enough structure, while memory stays bounded by the voxel.
 //
-// Candidates come from two sources (their union): earlier keyframes within `proximity_radius` of
-// the new one in the current (optimized) estimate, and the place database (place_database.hpp),
-// both skipping the newest `skip_recent` keyframes. Verification (loop_verification3d.hpp) needs
+// Candidates come from two sources (their union, loop_candidates.hpp): earlier keyframes near the
+// new one in the current (optimized) estimate, and the place database (place_database.hpp), both
+// skipping the newest `skip_recent` keyframes. Verification (loop_verification3d.hpp) needs
 // no prior: it starts from the relative pose the estimate implies (proximity) or from the
 // descriptor's yaw (database). A verified loop must also agree with the estimate (repeated
 // structure verifies perfectly at the wrong place); the graph's robust kernel and chi-square test
@@ -27,6 +27,7 @@
 #include "scanmatch/core/se3.hpp"
 #include "scanmatch/features/place_database.hpp"
 #include "scanmatch/mapping/keyframe_graph.hpp"
+#include "scanmatch/mapping/loop_candidates.hpp"
 #include "scanmatch/mapping/loop_verification3d.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
 
@@ -61,15 +62,16 @@ struct LoopClosure3DOptions {
   double loop_sigma_rotation = 0.5 * M_PI / 180;
   /// The newest keyframes are never candidates (they are trivially the same place).
   std::size_t skip_recent = 30;
-  /// Pose-proximity candidates: earlier keyframes within this distance (m) of the new one in the
-  /// current estimate, nearest first, at most `max_proximity_candidates` (0: none).
-  double proximity_radius = 8.0;
-  std::size_t max_proximity_candidates = 2;
-  /// Place-database candidates below this descriptor distance, at most this many (0: none),
-  /// taken from its best `descriptor_matches` matches: those the estimate rules out (below) are
-  /// skipped, since look-alike places often match better than the true one.
-  double max_descriptor_distance = 0.3;
-  std::size_t max_descriptor_candidates = 1;
+  /// Candidates (loop_candidates.hpp): earlier keyframes within 8 m in the current estimate, the 2
+  /// nearest of different visits, and the place database's best match below descriptor distance
+  /// 0.3 ...
+  LoopCandidateOptions candidates{.proximity_radius = 8.0,
+                                  .max_proximity_candidates = 2,
+                                  .max_descriptor_distance = 0.3,
+                                  .max_descriptor_candidates = 1};
+  /// ... taken from its best `descriptor_matches` matches: those the estimate rules out
+  /// (registration_reach) are skipped, since look-alike places often match better than the true
+  /// one.
   std::size_t descriptor_matches = 5;
   /// Repeated structure verifies perfectly at the wrong place, so a verified loop must also agree
   /// with the current estimate: its translation may differ from the estimate's relative pose by at
