@@ -13,10 +13,20 @@
 #include <vector>
 
 #include "scanmatch/core/scan2d.hpp"
+#include "scanmatch/mapping/loop_verification.hpp"
 
 namespace scanmatch {
 
-struct LoopVerification2DOptions {
+struct LoopVerification2DOptions : LoopVerificationOptions {
+  /// The shared thresholds (loop_verification.hpp) at a laser's scale: a current point is paired
+  /// when a candidate point lies within 0.1 m; their mean distance at most 0.04 m, checked both
+  /// ways (current onto candidate and back) like the paired share below; the normals (from beam
+  /// neighbours) give the weaker direction a share of 0.1 at least (a corridor's two walls give ~0
+  /// and slide along it to wherever the search window allows); 40 points in each scan.
+  LoopVerification2DOptions()
+      : LoopVerificationOptions{
+            .pair_distance = 0.1, .max_error = 0.04, .min_constraint = 0.1, .min_points = 40} {}
+
   std::string method = "pl-icp";  ///< registration_2d_methods() name of the fine stage
   /// Correlative search around the candidate's implied relative pose: +- m in x and y, +- rad.
   double search_window = 2.0;
@@ -29,26 +39,16 @@ struct LoopVerification2DOptions {
   /// 0.54 to 0.60); 0: every candidate is searched through.
   double min_search_score = 0.5;
   double max_correspondence_distance = 0.3;  ///< m, of the fine stage
-  /// A current point is paired when a candidate point lies within this distance after the
-  /// registration, m.
-  double pair_distance = 0.1;
   /// Accepted only when at least this share of the current points is paired (repeated structure
-  /// aligns partly; the same place aligns nearly everywhere the views overlap) ...
+  /// aligns partly; the same place aligns nearly everywhere the views overlap), checked both ways
+  /// so that a small scan inside a larger one does not pass.
   double min_paired_fraction = 0.65;
-  /// ... and the paired points' mean distance is below this, m. Both are checked both ways
-  /// (current onto candidate and back), so a small scan inside a larger one does not pass.
-  double max_error = 0.04;
   /// Negative evidence: a point of one scan that lies more than `free_margin` (m) in front of
   /// what the other scan saw along the same bearing sits in space the other saw empty. Different
   /// places that share a few walls put many points there; more than this share (either way)
   /// rejects.
   double free_margin = 0.3;
   double max_free_violations = 0.05;
-  /// Degeneracy: the paired points' surface normals (from beam neighbours) must constrain every
-  /// direction. The smaller eigenvalue of their mean n n^T (eigenvalues sum to 1) must reach this;
-  /// a corridor's two walls give ~0 and slide along it to wherever the search window allows.
-  double min_constraint = 0.1;
-  std::size_t min_points = 40;  ///< each scan needs this many points to be verified at all
   /// Rejected when the current scan, slid 1 to 3 m along the match's least determined direction,
   /// keeps more than this share of its paired points (an ambiguous place: a corridor with doors at
   /// even spacing). 0: not checked.

@@ -10,10 +10,20 @@
 
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/core/se3.hpp"
+#include "scanmatch/mapping/loop_verification.hpp"
 
 namespace scanmatch {
 
-struct LoopVerification3DOptions {
+struct LoopVerification3DOptions : LoopVerificationOptions {
+  /// The shared thresholds (loop_verification.hpp) at a submap's scale: a point is paired with
+  /// the other submap's nearest point within 1 m, and agrees when it also lies within
+  /// `plane_distance` of that point's tangent plane; the agreeing points' mean plane distance at
+  /// most 0.08 m; the normals (from the other submap's neighbourhoods) give the weakest
+  /// translation direction a share of 0.03 at least; 100 points in each submap.
+  LoopVerification3DOptions()
+      : LoopVerificationOptions{
+            .pair_distance = 1.0, .max_error = 0.08, .min_constraint = 0.03, .min_points = 100} {}
+
   /// Coarse stage: NDT on a wide grid converges from metres away (the descriptor's start has no
   /// translation at all).
   std::string coarse_method = "ndt";
@@ -22,22 +32,13 @@ struct LoopVerification3DOptions {
   std::string fine_method = "gicp";
   double fine_max_correspondence_distance = 1.0;  ///< m
   int max_iterations = 30;                        ///< of each stage
-  /// A point is paired with the other submap's nearest point within `pair_distance` (m) after
-  /// the registration, and agrees when it lies within `plane_distance` (m) of that point's tangent
+  /// A paired point agrees when it lies within this distance (m) of the other point's tangent
   /// plane (downsampled submaps sample a surface at different spots: the plane distance shows
   /// whether they agree, the point distance mostly shows the voxel).
-  double pair_distance = 1.0;
   double plane_distance = 0.2;
   /// Accepted only when at least this share of each submap's points agrees with the other
-  /// (checked both ways, so a small submap inside a larger one does not pass) ...
+  /// (checked both ways, so a small submap inside a larger one does not pass).
   double min_overlap = 0.5;
-  /// ... and the agreeing points' mean plane distance is below this, m.
-  double max_error = 0.08;
-  /// Degeneracy: the smallest eigenvalue of the paired points' mean n n^T (normals from the other
-  /// submap's neighbourhoods; eigenvalues sum to 1) must reach this. A tunnel or a corridor gives
-  /// ~0 along its axis and would slide to wherever the registration stopped.
-  double min_constraint = 0.03;
-  std::size_t min_points = 100;  ///< each submap needs this many points to be verified at all
 };
 
 /// The result of verifying one candidate: `transform` maps current points into the candidate's
