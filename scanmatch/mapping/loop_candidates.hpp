@@ -5,8 +5,10 @@
 // matches (place_database.hpp) below a descriptor distance, best first. The newest keyframes are
 // never candidates: they are the same place trivially.
 
+#include <algorithm>
 #include <cstddef>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "scanmatch/features/place_database.hpp"
@@ -51,20 +53,64 @@ struct LoopCandidates {
 /// still be a candidate; empty: any distance.
 using LoopCandidateReach = std::function<double(std::size_t k)>;
 
-/// The candidates of `keyframe` (node `keyframe` of `estimate`, entry `keyframe` of `places`)
-/// among the keyframes before the newest `skip_recent`. Of the place database, its best
+/// The candidates of `keyframe` (node `keyframe` of `estimate`, entry `keyframe` of `places`; 2D
+/// or 3D) among the keyframes before the newest `skip_recent`. Of the place database, its best
 /// `descriptor_matches` matches (at least max_descriptor_candidates) are looked at, best first:
 /// look-alike places often match better than the true one, so those farther than `reach` are
 /// skipped and the best remaining ones taken.
+template <int Dim, class Descriptor>
 LoopCandidates find_loop_candidates(std::size_t keyframe, std::size_t skip_recent,
-                                    const PoseGraph2D& estimate, const PlaceDatabase2D& places,
+                                    const PoseGraph<Dim>& estimate,
+                                    const PlaceDatabase<Descriptor>& places,
                                     const LoopCandidateOptions& options,
                                     std::size_t descriptor_matches = 0,
-                                    const LoopCandidateReach& reach = {});
-LoopCandidates find_loop_candidates(std::size_t keyframe, std::size_t skip_recent,
-                                    const PoseGraph3D& estimate, const PlaceDatabase3D& places,
-                                    const LoopCandidateOptions& options,
-                                    std::size_t descriptor_matches = 0,
-                                    const LoopCandidateReach& reach = {});
+                                    const LoopCandidateReach& reach = {}) {
+  LoopCandidates out;
+  if (keyframe <= skip_recent) return out;
+  out.end = keyframe - skip_recent;
+  const typename PoseGraph<Dim>::PoseType here = estimate.pose(keyframe);
+  const auto distance = [&](std::size_t k) {
+    return (estimate.pose(k).translation() - here.translation()).norm();
+  };
+  if (options.max_proximity_candidates > 0) {
+    std::vector<std::pair<double, std::size_t>> near;
+    for (std::size_t k = 0; k < out.end; ++k) {
+      const double d = distance(k);
+      if (d <= options.proximity_radius) near.emplace_back(d, k);
+    }
+    std::sort(near.begin(), near.end());
+    // Nearest first, but not several neighbours of one visit: they would verify the same loop.
+    std::vector<std::size_t> chosen;
+    for (const auto& [d, k] : near) {
+      if (chosen.size() >= options.max_proximity_candidates) break;
+      const bool same_visit = std::any_of(chosen.begin(), chosen.end(), [&](std::size_t c) {
+        return (c > k ? c - k : k - c) < skip_recent / 2 + 1;
+      });
+      if (same_visit) continue;
+      chosen.push_back(k);
+      out.candidates.push_back({k, false, 0.0});
+    }
+  }
+  if (options.max_descriptor_candidates > 0) {
+    const auto found =
+        places.query(places.at(keyframe), skip_recent + 1,
+                     std::max(descriptor_matches, options.max_descriptor_candidates));
+    std::size_t taken = 0;
+    for (const PlaceCandidate& c : found) {
+      if (taken >= options.max_descriptor_candidates) break;
+      if (c.distance > options.max_descriptor_distance || c.index >= out.end) continue;
+      const bool known = std::any_of(out.candidates.begin(), out.candidates.end(),
+                                     [&](const LoopCandidate& p) { return p.keyframe == c.index; });
+      if (known) continue;
+      if (reach && distance(c.index) > reach(c.index)) {
+        ++out.ruled_out;
+        continue;
+      }
+      out.candidates.push_back({c.index, true, c.yaw});
+      ++taken;
+    }
+  }
+  return out;
+}
 
 }  // namespace scanmatch
