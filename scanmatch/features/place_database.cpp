@@ -1,3 +1,4 @@
+// The place database: stored descriptors and their queries (place_database.hpp).
 #include "scanmatch/features/place_database.hpp"
 
 #include <algorithm>

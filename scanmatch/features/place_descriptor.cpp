@@ -1,3 +1,4 @@
+// The place descriptor: making and comparing polar grids (place_descriptor.hpp).
 #include "scanmatch/features/place_descriptor.hpp"
 
 #include <algorithm>

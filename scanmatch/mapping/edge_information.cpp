@@ -1,3 +1,4 @@
+// The information matrices of the pose graph's edges (edge_information.hpp).
 #include "scanmatch/mapping/edge_information.hpp"
 
 #include <Eigen/Eigenvalues>

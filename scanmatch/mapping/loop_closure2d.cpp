@@ -1,3 +1,5 @@
+// 2D loop closure's orchestration: keyframes, odometry edges, searches, optimizations
+// (loop_closure2d.hpp).
 #include "scanmatch/mapping/loop_closure2d.hpp"
 
 #include <Eigen/Eigenvalues>

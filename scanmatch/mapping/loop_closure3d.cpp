@@ -1,3 +1,5 @@
+// 3D loop closure's orchestration: keyframes and their submaps, odometry edges, searches,
+// optimizations (loop_closure3d.hpp).
 #include "scanmatch/mapping/loop_closure3d.hpp"
 
 #include <algorithm>

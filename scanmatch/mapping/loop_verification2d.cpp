@@ -1,3 +1,4 @@
+// Verifying a 2D loop candidate, with its overlap and free-space checks (loop_verification2d.hpp).
 #include "scanmatch/mapping/loop_verification2d.hpp"
 
 #include <Eigen/Eigenvalues>

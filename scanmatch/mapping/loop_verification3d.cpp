@@ -1,3 +1,4 @@
+// Verifying a 3D loop candidate, with its plane-distance overlap check (loop_verification3d.hpp).
 #include "scanmatch/mapping/loop_verification3d.hpp"
 
 #include <Eigen/Eigenvalues>
