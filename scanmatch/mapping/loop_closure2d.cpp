@@ -2,7 +2,6 @@
 // (loop_closure2d.hpp).
 #include "scanmatch/mapping/loop_closure2d.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <optional>
