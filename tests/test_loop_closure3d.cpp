@@ -118,7 +118,15 @@ TEST(LoopClosure3D, VerificationRejectsAWrongCandidate) {
   const LoopVerification3D same =
       verify_loop_3d(here, here, from_xyz_rpy(1.0, -0.5, 0.1, 0, 0, 0.17), verification);
   EXPECT_TRUE(same.accepted) << same.overlap << " " << same.error << " " << same.constraint;
+  EXPECT_FALSE(same.prechecked_out);
   EXPECT_LT(same.transform.translation().norm(), 0.05);
+  // The same frame 300 m away (beyond its range): the cheap pre-check rejects it before the fine
+  // stage.
+  PointCloud far_away = here;
+  for (Point& p : far_away.points) p.x() += 300.0f;
+  const LoopVerification3D far = verify_loop_3d(far_away, here, Pose::Identity(), verification);
+  EXPECT_FALSE(far.accepted);
+  EXPECT_TRUE(far.prechecked_out);
   // Frames 50 m apart on the same street: the descriptor's best yaw and the identity both start
   // from the wrong place, and nothing may verify.
   const PointCloud& there = frames.clouds[140];

@@ -9,12 +9,16 @@
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/geometry/covariance.hpp"
 #include "scanmatch/geometry/kdtree.hpp"
+#include "scanmatch/geometry/voxel_hash.hpp"
 #include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
 namespace {
 
 constexpr int kNormalNeighbours = 10;
+/// The pre-check's cells, in pair distances: wide enough for the fine stage's move from the
+/// coarse pose.
+constexpr double kPrecheckCells = 2.0;
 
 bool finite_cloud(const PointCloud& cloud) {
   return std::all_of(cloud.points.begin(), cloud.points.end(),
@@ -57,6 +61,17 @@ OverlapCheck check_overlap(const PointCloud& from, const PointCloud& onto, const
   return c;
 }
 
+// The share of `from`'s points moved by `T` that fall in a cell (of `cell` m) holding a point of
+// `onto`: a few hash probes a point, against the fine stage's k-d tree searches.
+double occupied_share(const PointCloud& from, const PointCloud& onto, const Pose& T, double cell) {
+  VoxelHashTable<char> occupied;
+  for (const Point& p : onto.points) occupied.find_or_insert(voxel_key(p.cast<double>(), cell));
+  std::size_t inside = 0;
+  for (const Point& p : from.points)
+    inside += occupied.find(voxel_key(T * p.cast<double>(), cell)) != VoxelHashTable<char>::kAbsent;
+  return static_cast<double>(inside) / static_cast<double>(std::max<std::size_t>(from.size(), 1));
+}
+
 // The smallest eigenvalue of the normals' scatter, normalised to trace 1: the share the weakest
 // translation direction gets (1/3 when the surfaces face every way, 0 in a tunnel).
 double weakest_direction(const Eigen::Matrix3d& normals) {
@@ -95,6 +110,18 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
   try {
     const Pose start = register_clouds(current, candidate, coarse, initial).transform;
     if (!is_valid_pose(start.matrix(), 1e-6)) return out;
+    // Before the fine stage (four fifths of a verification): a candidate whose submaps do not
+    // even share coarse cells at the coarse pose cannot reach min_overlap of points near each
+    // other's planes. Measured on every verification of avia_hku1 (20) and handheld-walk (53):
+    // each accepted loop had 0.60 or more of the current submap in such cells, while 6 and 28
+    // rejected ones fell below 0.5 and were spared the fine stage.
+    const double cell = kPrecheckCells * options.pair_distance;
+    out.transform = start;
+    if (occupied_share(current, candidate, start, cell) < options.min_overlap ||
+        occupied_share(candidate, current, start.inverse(), cell) < options.min_overlap) {
+      out.prechecked_out = true;
+      return out;
+    }
     result = register_clouds(current, candidate, fine, start);
   } catch (const Error&) {
     return out;  // too few usable points for a method: not verifiable, so not a loop

@@ -45,6 +45,9 @@ struct LoopVerification3DOptions : LoopVerificationOptions {
 /// frame (the loop edge's measurement T_candidate^-1 T_current).
 struct LoopVerification3D {
   bool accepted = false;
+  /// Rejected by the cheap pre-check before the fine stage (too little of either submap shares
+  /// a cell with the other at the coarse pose); the measures below are then unset.
+  bool prechecked_out = false;
   Pose transform = Pose::Identity();
   double overlap = 0.0;     ///< the smaller agreeing share of the two ways
   double error = 0.0;       ///< m, mean plane distance of the agreeing points (worse way)
