@@ -69,15 +69,18 @@ double MotionModel::steady_period() const {
                                                                                              : 0.0;
 }
 
+bool MotionModel::within_steady_period(double step) const {
+  return steady_period_ > 0.0 && std::abs(step / steady_period_ - 1.0) <= kSteadyJitter;
+}
+
 double MotionModel::as_period(double step) const {
-  return steady_period_ > 0.0 && std::abs(step / steady_period_ - 1.0) <= kSteadyJitter
-             ? steady_period_
-             : step;
+  return within_steady_period(step) ? steady_period_ : step;
 }
 
 void MotionModel::remember_step(double step) {
   // A steady sensor's odd step (a dropped frame) is not its period; a lasting change is.
-  if (as_period(step) != step && ++odd_steps_ < kSteadySteps) return;
+  const bool odd = steady_period_ > 0.0 && !within_steady_period(step);
+  if (odd && ++odd_steps_ < kSteadySteps) return;
   odd_steps_ = 0;
   recent_steps_.push_back(step);
   if (recent_steps_.size() > kSteadySteps) recent_steps_.pop_front();

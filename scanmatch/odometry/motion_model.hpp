@@ -58,6 +58,8 @@ class MotionModel {
   void scale_by_time_step();
   /// The mean of the recent time steps when they lie within jitter of it (a steady sensor), else 0.
   double steady_period() const;
+  /// A steady sensor's `step` that lies within jitter of its period.
+  bool within_steady_period(double step) const;
   /// `step`, or the steady period when it lies within jitter of it.
   double as_period(double step) const;
   void remember_step(double step);
