@@ -111,8 +111,9 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
     const Pose start = register_clouds(current, candidate, coarse, initial).transform;
     if (!is_valid_pose(start.matrix(), 1e-6)) return out;
     // Before the fine stage (four fifths of a verification): a candidate whose submaps do not
-    // even share coarse cells at the coarse pose cannot reach min_overlap of points near each
-    // other's planes. Measured on every verification of avia_hku1 (20) and handheld-walk (53):
+    // even share coarse cells at the coarse pose is not expected to reach min_overlap of points
+    // near each other's planes (an observation, not a bound: the fine stage moves the pose a
+    // little). Measured on every verification of avia_hku1 (20) and handheld-walk (53):
     // each accepted loop had 0.60 or more of the current submap in such cells, while 6 and 28
     // rejected ones fell below 0.5 and were spared the fine stage.
     const double cell = kPrecheckCells * options.pair_distance;

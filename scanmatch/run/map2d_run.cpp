@@ -178,8 +178,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
         optimized_map_error = e.what();
       }
     }
-    write_trajectory_atomic(file("poses_optimized_tum.txt"), optimized_trajectory,
-                            TrajectoryFormat::kTum);
+    write_trajectory(file("poses_optimized_tum.txt"), optimized_trajectory, TrajectoryFormat::kTum);
     for (const Loop2D& l : closure->loop_closure().loops()) {
       if (l.outlier) continue;
       loops_json.push_back({{"from", l.from_scan},

@@ -389,8 +389,8 @@ RunSummary run_odometry(SequenceSource& source, const OdometryConfig& config,
       Trajectory optimized;
       optimized.poses = summary.optimized_poses;
       optimized.timestamps = summary.timestamps;
-      write_trajectory_atomic(dir + "/poses_optimized.txt", optimized, TrajectoryFormat::kKitti);
-      write_trajectory_atomic(dir + "/poses_optimized_tum.txt", optimized, TrajectoryFormat::kTum);
+      write_trajectory(dir + "/poses_optimized.txt", optimized, TrajectoryFormat::kKitti);
+      write_trajectory(dir + "/poses_optimized_tum.txt", optimized, TrajectoryFormat::kTum);
       write_json_atomic(dir + "/loops.json",
                         loops_json(closure->loop_closure().loops(), reported_from_registered));
     }

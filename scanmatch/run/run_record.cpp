@@ -14,14 +14,6 @@ void create_run_folder(const std::string& path) {
   if (ec) fail(path, "cannot create the run folder: " + ec.message());
 }
 
-void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
-                             TrajectoryFormat format) {
-  write_trajectory(path + ".tmp", trajectory, format);
-  std::error_code ec;
-  std::filesystem::rename(path + ".tmp", path, ec);
-  if (ec) fail(path, "cannot replace the file: " + ec.message());
-}
-
 void write_json_atomic(const std::string& path, const nlohmann::ordered_json& j) {
   write_file_atomic(path, j.dump(2) + "\n");
 }

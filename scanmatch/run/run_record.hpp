@@ -10,7 +10,6 @@
 
 #include "scanmatch/io/line_writer.hpp"
 #include "scanmatch/io/record_csv.hpp"
-#include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/run/loop_closure_run.hpp"
 
 namespace scanmatch {
@@ -38,10 +37,6 @@ class TimingWriter {
  private:
   LineWriter out_;
 };
-
-/// Writes a whole trajectory atomically (tmp + rename); throws Error naming the file.
-void write_trajectory_atomic(const std::string& path, const Trajectory& trajectory,
-                             TrajectoryFormat format);
 
 /// Writes `j` (indented by 2, a final newline) atomically: summary.json, loops.json.
 void write_json_atomic(const std::string& path, const nlohmann::ordered_json& j);
