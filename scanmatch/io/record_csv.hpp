@@ -20,16 +20,6 @@ namespace scanmatch {
 
 namespace record_csv_detail {
 
-struct Keys {
-  std::string line = "index,timestamp";
-  template <typename T>
-  void operator()(const char* key, const T&, const char*) {
-    line += ',';
-    line += key;
-  }
-  void stage(const char* key, double ms, const char*, const char* help) { (*this)(key, ms, help); }
-};
-
 struct Cells {
   std::string line;
   template <typename T>
@@ -79,17 +69,19 @@ struct Reader {
     if (!parse_cell(cell, field))
       fail(path, where, std::string(key) + ": not a valid value: '" + cell + "'");
   }
-  void stage(const char* key, double& ms, const char*, const char* help) { (*this)(key, ms, help); }
 };
 
 }  // namespace record_csv_detail
 
 template <typename Record>
 std::string record_csv_header() {
-  record_csv_detail::Keys keys;
+  std::string line = "index,timestamp";
   const Record defaults{};
-  describe(defaults, keys);
-  return keys.line;
+  for_each_field(defaults, [&](const char* key, const auto&, const char*) {
+    line += ',';
+    line += key;
+  });
+  return line;
 }
 
 template <typename Record>
@@ -113,7 +105,7 @@ std::vector<TimingRow<Record>> read_record_csv(const std::string& path,
                                      "line " + std::to_string(table.line_numbers[r])};
     reader("index", row.index, nullptr);
     reader("timestamp", row.timestamp, nullptr);
-    describe(row.stats, reader);
+    for_each_field(row.stats, reader);
     rows.push_back(row);
   }
   return rows;
