@@ -448,6 +448,29 @@ TEST(AdaptiveRules, RankedStartsRecoverTheTurnWithFewerFullSolves) {
   EXPECT_LT(ranked.iterations, every.iterations / 2);
 }
 
+TEST(AdaptiveRules, AThinnedWideDescentRecoversTheSameTurn) {
+  // The starts' descent on the wider grid with one point per start_voxel_size (1 m) instead of
+  // every coarse point (each of its iterations then costs less): the turned start must still win,
+  // where the descents on every point put it. (Speed: docs/benchmarks.md.)
+  const MissedTurn m = avia_missed_turn();
+  if (m.frame.empty()) GTEST_SKIP() << "../shared/data/3d/avia_hku1 not present";
+  const auto align = [&](double start_voxel_size) {
+    OdometryConfig c;
+    c.start_voxel_size = start_voxel_size;
+    CoarseNdt coarse(c);
+    coarse.set_reference(m.reference_frame, false);
+    return coarse.align(m.frame, m.prior);
+  };
+  const CoarseResult thinned = align(OdometryConfig{}.start_voxel_size);
+  const CoarseResult every = align(0.0);
+  ASSERT_GT(OdometryConfig{}.start_voxel_size, OdometryConfig{}.coarse_voxel_size);
+  const Pose between = every.motion.inverse() * thinned.motion;
+  EXPECT_TRUE(thinned.recovered);
+  EXPECT_LT(rotation_angle(between) * kDegreesPerRadian, 0.2);
+  EXPECT_LT(between.translation().norm(), 0.02);
+  EXPECT_LT(rotation_angle(m.truth.inverse() * thinned.motion) * kDegreesPerRadian, 1.0);
+}
+
 TEST(AdaptiveRules, AWideStartRecoversACarEnteringATurn) {
   // urban-hdl64 frames 216 -> 217: the car (8 m/s) enters a 12 m turn at the crossing and turns
   // 3.2 deg in the step, while the constant-velocity prior (the straight step before) turns none.

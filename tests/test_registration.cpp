@@ -119,6 +119,49 @@ TEST(Solver, ExactCorrespondencesConvergeImmediately) {
   EXPECT_TRUE(r.transform.isApprox(truth, 1e-6));
 }
 
+TEST(Solver, ACallersStopEndsTheSolveWhereItSays) {
+  // A large rotation takes Gauss-Newton several steps; a caller that knows where the descent
+  // leads (as the coarse stage does for a start reaching another start's optimum) ends it there.
+  PointCloud target;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-5, 5);
+  for (int i = 0; i < 300; ++i) target.points.emplace_back(u(rng), u(rng), u(rng));
+  const Pose truth = from_xyz_rpy(1.0, -0.5, 0.2, 0.3, -0.2, 0.9);
+  PointCloud source;
+  for (const Point& q : target.points)
+    source.points.push_back((truth.inverse() * q.cast<double>()).cast<float>());
+  struct Exact {
+    const PointCloud& s;
+    const PointCloud& t;
+    std::size_t size() const { return s.size(); }
+    bool linearize(const Pose& T, std::size_t i, LinearSystem& sys, const RobustKernel& k) const {
+      const Eigen::Vector3d p = s.points[i].cast<double>();
+      sys.add<3>(point_jacobian(T, p), T * p - t.points[i].cast<double>(),
+                 Eigen::Matrix3d::Identity(), k);
+      return true;
+    }
+  };
+  const Exact factor{source, target};
+  const RegistrationResult full = optimize(factor, Pose::Identity(), SolverOptions{});
+  ASSERT_TRUE(full.converged);
+  ASSERT_GE(full.iterations, 3);
+  const auto near_truth = [&](const Pose& T) {
+    const Pose d = truth.inverse() * T;
+    return d.translation().norm() < 0.1 && rotation_angle(d) < 0.1;
+  };
+  int asked = 0;
+  const RegistrationResult stopped =
+      optimize(factor, Pose::Identity(), SolverOptions{}, [&](const Pose& T) {
+        ++asked;
+        return near_truth(T);
+      });
+  EXPECT_EQ(stopped.stop_reason, "stopped by the caller");
+  EXPECT_FALSE(stopped.converged);
+  EXPECT_TRUE(near_truth(stopped.transform));
+  EXPECT_LT(stopped.iterations, full.iterations);
+  EXPECT_EQ(asked, stopped.iterations);  // asked once per accepted step, and it ended at the first
+}
+
 TEST(Solver, CorridorInformationIsDegenerateAlongItsAxis) {
   // Two parallel walls and a floor along x: nothing constrains translation along x. (Walls and
   // floor do not touch: an L-shaped neighbourhood would give a normal along x.)

@@ -81,6 +81,9 @@ void describe(OdometryConfig& c, Visitor& v) {
     "ctf-icp: angle between turned starts, rad");
   v("uncertain_ndt_scale", c.uncertain_ndt_scale, nullptr,
     "ctf-icp: those starts run first on an NDT grid this many times ndt_resolution");
+  v("start_voxel_size", c.start_voxel_size, nullptr,
+    "ctf-icp: the descent on the wider grid takes the coarse points downsampled to this (m; at "
+    "most coarse_voxel_size: no further downsampling)");
   v("wide_start_iterations", c.wide_start_iterations, nullptr,
     "ctf-icp: a certain prior whose NDT solve took this many iterations also starts on the wider "
     "grid (uncertain_ndt_scale), kept when it scores better (0: never)");

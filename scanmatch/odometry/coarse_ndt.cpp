@@ -33,12 +33,30 @@ NdtFactor hinted_factor(const PointCloud& source, const GaussianVoxelMap& grid,
   return factor;
 }
 
+/// Two motions this close are one for the coarse stage (the fine stage refines either): starts
+/// this close are solved once, and a descent this close to an optimum ends there.
 bool near(const Pose& a, const Pose& b) {
   const Pose d = a.inverse() * b;
   return d.translation().norm() < 0.05 && rotation_angle(d) < 0.01;
 }
 
 }  // namespace
+
+/// Where the solves of one frame ended on one grid. Most starts of a frame reach the same optimum,
+/// and a descent that comes `near` one ends there: the rest of its solve is saved.
+struct KnownOptima {
+  std::vector<Pose> poses;
+  /// The optimum `motion` has reached, or null.
+  const Pose* reached(const Pose& motion) const {
+    for (const Pose& o : poses)
+      if (near(o, motion)) return &o;
+    return nullptr;
+  }
+  /// The solver's stop: at a known optimum.
+  auto stop() const {
+    return [this](const Pose& motion) { return reached(motion) != nullptr; };
+  }
+};
 
 CoarseNdt::CoarseNdt(const OdometryConfig& config)
     : config_(config), grid_(grid_options(config.ndt_resolution)) {
@@ -59,6 +77,10 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
                                  ? voxel_downsample(frame, config_.coarse_voxel_size)
                                  : PointCloud{};
   const PointCloud& source = sparser.empty() ? frame : sparser;
+  const bool try_starts = prior.uncertain && config_.uncertain_starts && !reference_.empty();
+  const std::vector<Pose> starts = try_starts ? distinct_starts(prior.motion) : std::vector<Pose>{};
+  const bool screen = try_starts && should_screen(starts.size(), source.size());
+
   const NdtFactor factor = hinted_factor(source, grid_, config_);
   const RegistrationResult plain = optimize(factor, prior.motion, solver_);
   result.iterations = plain.iterations;
@@ -66,18 +88,28 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   result.registered = plain.inliers >= kMinimumFramePoints;
   if (result.registered) result.motion = plain.transform;
   // A certain prior whose solve was slow to settle may have stopped in a ripple of the grid.
-  const bool slow =
-      config_.wide_start_iterations > 0 && plain.iterations >= config_.wide_start_iterations;
-  if (prior.uncertain || slow)
-    result.motion = best_start(source, result.motion, prior.motion, prior.uncertain,
-                               result.iterations, result.screen_iterations, result.recovered);
+  const bool slow = !prior.uncertain && config_.wide_start_iterations > 0 &&
+                    plain.iterations >= config_.wide_start_iterations && !reference_.empty();
+  KnownOptima optima;
+  if (plain.converged) optima.poses.push_back(result.motion);
+  std::vector<Pose> solved;
+  if (screen) {
+    const std::vector<Pose> ranked =
+        screened_starts(source, starts, result.motion, result.screen_iterations);
+    solved = solve_starts(source, ranked, false, optima, result.iterations);
+  } else if (try_starts) {
+    solved = solve_starts(source, starts, true, optima, result.iterations);
+  } else if (slow) {
+    solved = solve_starts(source, {prior.motion}, true, optima, result.iterations);
+  }
+  result.motion = best_of(source, result.motion, solved, result.recovered);
   return result;
 }
 
-std::vector<Pose> CoarseNdt::other_starts(const Pose& prior_motion, bool uncertain) const {
-  if (!uncertain) return {prior_motion};
-  std::vector<Pose> starts = {prior_motion, Pose(Pose::Identity()),
-                              scaled_motion(prior_motion, 0.5), scaled_motion(prior_motion, 2.0)};
+std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion) const {
+  std::vector<Pose> candidates = {prior_motion, Pose(Pose::Identity()),
+                                  scaled_motion(prior_motion, 0.5),
+                                  scaled_motion(prior_motion, 2.0)};
   // About the sensor's z axis: sensors are mounted upright, and hand-held ones sweep mostly about
   // the vertical. (The prior's own axis was tried: avia_hku1 1.5 % against 0.16 %.)
   for (int k = 1; k <= config_.rotation_starts; ++k)
@@ -87,15 +119,55 @@ std::vector<Pose> CoarseNdt::other_starts(const Pose& prior_motion, bool uncerta
           prior_motion.linear() *
           Eigen::AngleAxisd(side * k * config_.rotation_start_step, Eigen::Vector3d::UnitZ())
               .toRotationMatrix();
-      starts.push_back(turned);
+      candidates.push_back(turned);
     }
+  std::vector<Pose> starts;
+  for (const Pose& start : candidates) {
+    bool seen = false;
+    for (const Pose& t : starts) seen = seen || near(t, start);
+    if (!seen) starts.push_back(start);
+  }
   return starts;
 }
 
-Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                           bool uncertain, int& iterations, int& screen_iterations,
-                           bool& recovered) const {
-  if ((uncertain && !config_.uncertain_starts) || reference_.empty()) return plain;
+std::vector<Pose> CoarseNdt::solve_starts(const PointCloud& source, const std::vector<Pose>& starts,
+                                          bool from_wide_grid, KnownOptima& optima,
+                                          int& iterations) const {
+  const NdtFactor normal = hinted_factor(source, grid_, config_);
+  // The descent on the wider grid only has to reach the normal grid's basin: sparser points do.
+  const PointCloud sparser = from_wide_grid && config_.start_voxel_size > config_.coarse_voxel_size
+                                 ? voxel_downsample(source, config_.start_voxel_size)
+                                 : PointCloud{};
+  const PointCloud& wide_source = sparser.size() >= 2 * kMinimumFramePoints ? sparser : source;
+  const std::optional<NdtFactor> widened_factor =
+      from_wide_grid ? std::optional<NdtFactor>(hinted_factor(wide_source, wide_grid(), config_))
+                     : std::nullopt;
+  KnownOptima wide_optima;
+  std::vector<Pose> solved;
+  for (const Pose& start : starts) {
+    Pose refined_start = start;
+    if (widened_factor) {
+      const RegistrationResult widened =
+          optimize(*widened_factor, start, solver_, wide_optima.stop());
+      iterations += widened.iterations;
+      if (widened.inliers < kMinimumFramePoints || !to_matrix(widened.transform).allFinite() ||
+          wide_optima.reached(widened.transform))
+        continue;
+      if (widened.converged) wide_optima.poses.push_back(widened.transform);
+      refined_start = widened.transform;
+    }
+    const RegistrationResult refined = optimize(normal, refined_start, solver_, optima.stop());
+    iterations += refined.iterations;
+    if (!to_matrix(refined.transform).allFinite() || optima.reached(refined.transform)) continue;
+    if (refined.converged) optima.poses.push_back(refined.transform);
+    solved.push_back(refined.transform);
+  }
+  return solved;
+}
+
+Pose CoarseNdt::best_of(const PointCloud& source, const Pose& plain,
+                        const std::vector<Pose>& solved, bool& recovered) const {
+  if (solved.empty()) return plain;
   const NdtFactor normal = hinted_factor(source, grid_, config_);
   const auto score = [&](const Pose& motion, std::size_t& inliers) {
     const LinearSystem s = linearize_all(normal, motion, solver_);
@@ -105,42 +177,11 @@ Pose CoarseNdt::best_start(const PointCloud& source, const Pose& plain, const Po
   std::size_t inliers = 0;
   double best_cost = score(plain, inliers);
   Pose best = plain;
-
-  // The wider grid of the reference frame: a basin a few times the normal one. Built once per
-  // reference, on first use.
-  if (!wide_grid_) {
-    wide_grid_.emplace(grid_options(config_.ndt_resolution * config_.uncertain_ndt_scale));
-    wide_grid_->insert(reference_);
-  }
-  const NdtFactor widened_factor = hinted_factor(source, *wide_grid_, config_);
-
-  std::vector<Pose> starts;
-  for (const Pose& start : other_starts(prior_motion, uncertain)) {
-    bool seen = false;
-    for (const Pose& t : starts) seen = seen || near(t, start);
-    if (!seen) starts.push_back(start);
-  }
-  // Each start solved on every point from its own pose: the old way, and the fallback.
-  bool from_wide_grid = true;
-  if (should_screen(starts.size(), source.size()))
-    starts = screened_starts(source, starts, plain, screen_iterations, from_wide_grid);
-
-  for (const Pose& start : starts) {
-    Pose refined_start = start;
-    if (from_wide_grid) {
-      const RegistrationResult widened = optimize(widened_factor, start, solver_);
-      iterations += widened.iterations;
-      if (widened.inliers < kMinimumFramePoints || !to_matrix(widened.transform).allFinite())
-        continue;
-      refined_start = widened.transform;
-    }
-    const RegistrationResult refined = optimize(normal, refined_start, solver_);
-    iterations += refined.iterations;
-    if (!to_matrix(refined.transform).allFinite()) continue;
-    const double cost = score(refined.transform, inliers);
+  for (const Pose& motion : solved) {
+    const double cost = score(motion, inliers);
     if (inliers >= kMinimumFramePoints && cost < best_cost - kScoreMargin * std::abs(best_cost)) {
       best_cost = cost;
-      best = refined.transform;
+      best = motion;
       recovered = true;
     }
   }
@@ -156,7 +197,7 @@ bool CoarseNdt::should_screen(std::size_t start_count, std::size_t source_points
 
 std::vector<Pose> CoarseNdt::screened_starts(const PointCloud& source,
                                              const std::vector<Pose>& starts, const Pose& plain,
-                                             int& screen_iterations, bool& from_wide_grid) const {
+                                             int& screen_iterations) const {
   // Every stride-th point: the source is already one point per coarse voxel, so the subset stays
   // spread over the scene.
   const std::size_t stride = source.size() / config_.start_screen_points;
@@ -164,7 +205,7 @@ std::vector<Pose> CoarseNdt::screened_starts(const PointCloud& source,
   for (std::size_t i = 0; i < source.size(); i += stride) kept.push_back(i);
   const PointCloud subset = select(source, kept);
   const NdtFactor normal = hinted_factor(subset, grid_, config_);
-  const NdtFactor widened = hinted_factor(subset, *wide_grid_, config_);
+  const NdtFactor widened = hinted_factor(subset, wide_grid(), config_);
   const auto subset_cost = [&](const Pose& motion) {
     const LinearSystem s = linearize_all(normal, motion, solver_);
     return s.inliers >= kMinimumFramePoints ? s.cost : 0.0;
@@ -194,9 +235,15 @@ std::vector<Pose> CoarseNdt::screened_starts(const PointCloud& source,
     for (const Pose& b : best) seen = seen || near(b, motion);
     if (!seen) best.push_back(motion);
   }
-  // The screened poses are already in the normal grid's basin.
-  from_wide_grid = false;
   return best;
+}
+
+const GaussianVoxelMap& CoarseNdt::wide_grid() const {
+  if (!wide_grid_) {
+    wide_grid_.emplace(grid_options(config_.ndt_resolution * config_.uncertain_ndt_scale));
+    wide_grid_->insert(reference_);
+  }
+  return *wide_grid_;
 }
 
 void CoarseNdt::set_reference(PointCloud frame, bool bridged) {

@@ -6,13 +6,16 @@
 // Under an uncertain prior (motion_model.hpp) it also tries other starts: the identity, half and
 // twice the prior, and the prior turned about the sensor's z axis by +-k * rotation_start_step
 // (a hand-held sweep that reverses leaves the constant-velocity rotation several degrees off, out
-// of NDT's basin), each first on a grid uncertain_ndt_scale times wider, then on the normal grid;
-// the start whose result scores best on the normal grid (by a margin) wins. With
-// start_screen_points set and more starts than start_full_solves, the starts are first solved on a
-// spread subset of about start_screen_points points and ranked by their score there; only the best
-// few that beat the plain result on the subset are solved again on every point (most frames: none).
-// A certain prior whose solve took wide_start_iterations or more (slow: it may have stopped in a
-// ripple of the grid, as when a car enters a turn) gets the prior itself as the one other start.
+// of NDT's basin), each first on a grid uncertain_ndt_scale times wider (with the points thinned to
+// start_voxel_size: that descent only has to reach the normal grid's basin), then on the normal
+// grid; the start whose result scores best on the normal grid (by a margin) wins. Most starts reach
+// the same optimum: a solve that comes `near` an optimum another solve converged to ends there.
+// With start_screen_points set and more starts than start_full_solves, the starts are first solved
+// on a spread subset of about start_screen_points points and ranked by their score there; only the
+// best few that beat the plain result on the subset are solved again on every point (most frames:
+// none). A certain prior whose solve took wide_start_iterations or more (slow: it may have stopped
+// in a ripple of the grid, as when a car enters a turn) gets the prior itself as the one other
+// start.
 
 #include <cstddef>
 #include <optional>
@@ -25,6 +28,8 @@
 #include "scanmatch/registration/solver.hpp"
 
 namespace scanmatch {
+
+struct KnownOptima;
 
 struct CoarseResult {
   Pose motion = Pose::Identity();  ///< from the reference frame (the prior when not registered)
@@ -49,28 +54,34 @@ class CoarseNdt {
   const PointCloud& reference() const { return reference_; }
 
  private:
-  /// The best motion among `plain` and the other starts (adds their iterations; `recovered`
-  /// when another start won).
-  Pose best_start(const PointCloud& source, const Pose& plain, const Pose& prior_motion,
-                  bool uncertain, int& iterations, int& screen_iterations, bool& recovered) const;
-  /// The starts to try, `prior_motion` first: only it for a certain prior.
-  std::vector<Pose> other_starts(const Pose& prior_motion, bool uncertain) const;
+  /// The other starts under an uncertain prior, `prior_motion` first, none within `near` of an
+  /// earlier one.
+  std::vector<Pose> distinct_starts(const Pose& prior_motion) const;
+  /// Solves each start (on the wider grid first when `from_wide_grid`, then on the normal grid)
+  /// and returns the optima not already in `optima`, adding them there; a solve that reaches a
+  /// known optimum stops. Adds the iterations.
+  std::vector<Pose> solve_starts(const PointCloud& source, const std::vector<Pose>& starts,
+                                 bool from_wide_grid, KnownOptima& optima, int& iterations) const;
+  /// The best of `plain` and `solved` by NDT score on the normal grid; another replaces `plain`
+  /// only when better by kScoreMargin (then `recovered`).
+  Pose best_of(const PointCloud& source, const Pose& plain, const std::vector<Pose>& solved,
+               bool& recovered) const;
   /// Whether `start_count` starts on `source_points` points are ranked on a subset first.
   bool should_screen(std::size_t start_count, std::size_t source_points) const;
   /// Solves each start (wider grid, then normal grid) on about start_screen_points of `source`
   /// and returns the start_full_solves best results that score better than `plain` there (none:
-  /// the plain result stands). Sets `from_wide_grid` false: they need only the normal grid on
-  /// every point.
+  /// the plain result stands). They are in the normal grid's basin: solved again on it alone.
   std::vector<Pose> screened_starts(const PointCloud& source, const std::vector<Pose>& starts,
-                                    const Pose& plain, int& screen_iterations,
-                                    bool& from_wide_grid) const;
+                                    const Pose& plain, int& screen_iterations) const;
+  /// reference_'s grid uncertain_ndt_scale times wider: a basin a few times the normal one.
+  const GaussianVoxelMap& wide_grid() const;
 
   OdometryConfig config_;
   SolverOptions solver_;
   GaussianVoxelMap grid_;  ///< the reference frame's NDT grid, in its sensor frame
   PointCloud reference_;
-  /// reference_'s grid uncertain_ndt_scale times wider, built on first use by best_start (so
-  /// align() is not safe to call from two threads at once on one CoarseNdt).
+  /// wide_grid(), built on first use (so align() is not safe to call from two threads at once on
+  /// one CoarseNdt).
   mutable std::optional<GaussianVoxelMap> wide_grid_;
 };
 

@@ -225,10 +225,13 @@ LinearSystem linearize_all(const Factor& factor, const Pose& T, const SolverOpti
 
 void finish_result(RegistrationResult& result, const LinearSystem& system);
 
-/// Minimises the factor's cost over T starting from `initial`.
-template <typename Factor>
-RegistrationResult optimize(const Factor& factor, const Pose& initial,
-                            const SolverOptions& options) {
+/// Minimises the factor's cost over T starting from `initial`. `stop_at(T)` is asked after every
+/// accepted step; true ends the solve there (stop_reason "stopped by the caller"): a caller that
+/// knows where a pose leads, such as one of several starts reaching an optimum another start
+/// already found, saves the rest of the descent.
+template <typename Factor, typename StopAt>
+RegistrationResult optimize(const Factor& factor, const Pose& initial, const SolverOptions& options,
+                            const StopAt& stop_at) {
   RegistrationResult result;
   Pose T = initial;
   double lambda = options.initial_lambda;
@@ -281,6 +284,10 @@ RegistrationResult optimize(const Factor& factor, const Pose& initial,
       result.stop_reason = "update below tolerance";
       break;
     }
+    if (stop_at(T)) {
+      result.stop_reason = "stopped by the caller";
+      break;
+    }
     if (options.relative_cost_tolerance > 0.0 &&
         std::abs(previous_cost - system.cost) <=
             options.relative_cost_tolerance * std::max(std::abs(previous_cost), 1e-30)) {
@@ -292,6 +299,13 @@ RegistrationResult optimize(const Factor& factor, const Pose& initial,
   result.transform = T;
   finish_result(result, system);
   return result;
+}
+
+/// Minimises the factor's cost over T starting from `initial`.
+template <typename Factor>
+RegistrationResult optimize(const Factor& factor, const Pose& initial,
+                            const SolverOptions& options) {
+  return optimize(factor, initial, options, [](const Pose&) { return false; });
 }
 
 }  // namespace scanmatch
