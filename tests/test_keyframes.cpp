@@ -12,6 +12,7 @@
 #include <set>
 
 #include "scanmatch/eval/metrics.hpp"
+#include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/trajectory.hpp"
@@ -350,12 +351,46 @@ TEST(AdaptiveRules, ASparseFrameKeepsMorePointsADenseOneIsUnchanged) {
                              -1.0f + 2.0f * float(i / 100) / 100.0f);
   EXPECT_EQ(adaptive_downsample(wall, wall.size(), o).points,
             voxel_downsample(wall, c.voxel_size).points);
-  // 40 x 40 m of ground every 0.1 m: 25600 voxels, more than enough.
-  for (int i = 0; i < 400; ++i)
-    for (int j = 0; j < 400; ++j)
-      dense.points.emplace_back(-20.0f + 0.1f * i, -20.0f + 0.1f * j, -1.0f);
+  // 30 x 30 m of ground every 0.1 m: 14400 voxels, more than enough and under the ceiling.
+  for (int i = 0; i < 300; ++i)
+    for (int j = 0; j < 300; ++j)
+      dense.points.emplace_back(-15.0f + 0.1f * i, -15.0f + 0.1f * j, -1.0f);
+  ASSERT_LT(voxel_downsample(dense, c.voxel_size).size(), c.max_downsampled_points);
   EXPECT_EQ(adaptive_downsample(dense, dense.size(), o).points,
             voxel_downsample(dense, c.voxel_size).points);
+}
+
+TEST(AdaptiveRules, ADenseScanIsThinnedToThePointCeiling) {
+  // A simulated 64-beam car scan (~117k points) keeps more than max_downsampled_points at
+  // voxel_size: it is thinned to about that many, and as evenly (every kept point still stands
+  // for a voxel of the plain filter's cloud nearby).
+  sim::SimOptions so;
+  so.preset = "urban-hdl64";
+  so.motion_distortion = false;
+  const sim::Simulator simulator(so);
+  const PointCloud scan = simulator.frame(10);
+  OdometryConfig c;
+  const PointCloud plain = voxel_downsample(scan, c.voxel_size);
+  c.max_downsampled_points = static_cast<std::uint32_t>(plain.size() / 2);
+  const PointCloud thinned = adaptive_downsample(scan, scan.size(), preprocess_options(c, false));
+  EXPECT_GT(thinned.size(), 0.6 * c.max_downsampled_points);
+  EXPECT_LT(thinned.size(), 1.25 * c.max_downsampled_points);
+  // The thinned cloud covers what the plain one covers: each plain point has a thinned one within
+  // the larger voxel's diagonal.
+  const KdTree tree(thinned.points);
+  const double larger_voxel = c.voxel_size * std::sqrt(2.0);
+  std::size_t far = 0;
+  for (const Point& p : plain.points) {
+    std::size_t index = 0;
+    float squared = 0.0f;
+    if (!tree.nearest(p, static_cast<float>(3.0 * larger_voxel * larger_voxel), index, squared))
+      ++far;
+  }
+  EXPECT_EQ(far, 0u);
+  // Off (0), or under the ceiling: the plain filter.
+  c.max_downsampled_points = 0;
+  EXPECT_EQ(adaptive_downsample(scan, scan.size(), preprocess_options(c, false)).points,
+            plain.points);
 }
 
 namespace {

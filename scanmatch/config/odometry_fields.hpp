@@ -15,6 +15,8 @@ void describe(OdometryConfig& c, Visitor& v) {
     "ctf-icp: the coarse stage's NDT grid of the previous frame, m");
   v("ndt_neighbours", c.ndt_neighbours, nullptr, "ctf-icp coarse: voxels per point");
   v("coarse_voxel_size", c.coarse_voxel_size, nullptr, "ctf-icp: downsampling of the NDT source");
+  v("max_coarse_points", c.max_coarse_points, nullptr,
+    "ctf-icp: a denser NDT source is thinned further, to about this many points (0: no limit)");
   v("coarse_max_iterations", c.coarse_max_iterations, "--coarse-max-iterations",
     "ctf-icp: the coarse NDT stage's iteration limit");
   v("coarse_tolerance", c.coarse_tolerance, nullptr,
@@ -99,6 +101,9 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("min_downsampled_points", c.min_downsampled_points, nullptr,
     "sparse frames (below 10x this) keeping fewer points get smaller voxels, to voxel_size / 4 "
     "(0: off)");
+  v("max_downsampled_points", c.max_downsampled_points, nullptr,
+    "frames keeping more points after the voxel filter are filtered again with larger voxels, to "
+    "about this many (0: no limit)");
   v("dense_sparse_map", c.dense_sparse_map, nullptr,
     "ctf-icp, sparse frames: the map gets the frame at voxel_size / 4, so one keyframe makes "
     "usable map voxels");

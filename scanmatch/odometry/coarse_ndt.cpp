@@ -7,6 +7,7 @@
 
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
+#include "scanmatch/odometry/preprocessor.hpp"
 #include "scanmatch/registration/factors/ndt.hpp"
 
 namespace scanmatch {
@@ -73,9 +74,11 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   result.motion = prior.motion;
   if (grid_.size() == 0) return result;
   // A sparser cloud: the stage only has to bring the fine stage into its basin.
-  const PointCloud sparser = config_.coarse_voxel_size > config_.voxel_size
-                                 ? voxel_downsample(frame, config_.coarse_voxel_size)
-                                 : PointCloud{};
+  const PointCloud sparser =
+      config_.coarse_voxel_size > config_.voxel_size
+          ? thin_to_points(voxel_downsample(frame, config_.coarse_voxel_size),
+                           config_.coarse_voxel_size, config_.max_coarse_points)
+          : PointCloud{};
   const PointCloud& source = sparser.empty() ? frame : sparser;
   const bool try_starts = prior.uncertain && config_.uncertain_starts && !reference_.empty();
   const std::vector<Pose> starts = try_starts ? distinct_starts(prior.motion) : std::vector<Pose>{};

@@ -19,6 +19,10 @@ struct OdometryConfig {
   double ndt_resolution = 1.0;     ///< m, the NDT grid of the previous frame
   int ndt_neighbours = 1;          ///< voxels per point: 1, 7 or 27
   double coarse_voxel_size = 0.7;  ///< m, further downsampling of the NDT source (0: none)
+  /// A denser NDT source is thinned further, to about this many points (0: no limit). The stage
+  /// only has to reach the fine stage's basin, and its cost grows with the points: a 64-beam car
+  /// scan keeps 11k at 0.7 m, a Livox frame 1-2k (docs/benchmarks.md, "Dense scans").
+  std::uint32_t max_coarse_points = 4000;
   int coarse_max_iterations = 30;
   double coarse_tolerance = 1e-4;  ///< m and rad: the coarse stage stops below this update
   // Fine stage (ctf-icp): frame-to-map.
@@ -133,6 +137,11 @@ struct OdometryConfig {
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
   std::uint32_t min_downsampled_points = 1000;
+  /// Frames keeping more points after the voxel filter are filtered again with voxels as much
+  /// larger as brings them to about this many (0: no limit). A 64-beam car scan keeps ~40k at
+  /// 0.25 m: every later stage touches each of them, and twice the points made no pose better
+  /// (kitti_raw_0027_first60, sim:urban-hdl64, sim:campus-os1: docs/benchmarks.md, "Dense scans").
+  std::uint32_t max_downsampled_points = 20000;
   /// ctf-icp, sparse frames (as above): the map receives the frame filtered at voxel_size / 4,
   /// not the registration's points. A 0.5 m map voxel on a plane gets at most about 4 points of a
   /// 0.25 m-filtered frame, fewer than the 5 the fine stage needs: keyframes that turn into new

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 #include "scanmatch/geometry/voxel_filter.hpp"
 
@@ -51,6 +52,7 @@ PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_att
   o.max_range = config.max_range;
   o.voxel_size = config.voxel_size;
   o.min_downsampled_points = config.min_downsampled_points;
+  o.max_downsampled_points = config.max_downsampled_points;
   o.keep_attributes = keep_attributes;
   return o;
 }
@@ -104,14 +106,22 @@ PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
   // Only frames delivered sparse (FAST-LIO keyframes): a dense frame that keeps few points sees a
   // near wall or is mostly within min_range, and finer voxels there did not help (dynamic-indoor:
   // 0.1864 -> 0.1878 % ATE when applied to those frames too).
-  if (!sparse_frame(delivered, options)) return down;
+  if (!sparse_frame(delivered, options))
+    return thin_to_points(std::move(down), voxel, options.max_downsampled_points);
   // Halve the voxel (twice at most) while a sparse frame keeps too few points to register.
   for (int k = 0;
        k < 2 && down.size() < options.min_downsampled_points && down.size() < cloud.size(); ++k) {
     voxel *= 0.5;
     down = voxel_downsample(cloud, voxel);
   }
-  return down;
+  return thin_to_points(std::move(down), voxel, options.max_downsampled_points);
+}
+
+PointCloud thin_to_points(PointCloud cloud, double voxel, std::size_t max_points) {
+  if (max_points == 0 || cloud.size() <= max_points || !(voxel > 0.0)) return cloud;
+  const double scale =
+      std::sqrt(static_cast<double>(cloud.size()) / static_cast<double>(max_points));
+  return voxel_downsample(cloud, voxel * scale);
 }
 
 }  // namespace scanmatch

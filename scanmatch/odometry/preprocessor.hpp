@@ -8,7 +8,8 @@
 //   mid-frame (the reference the registration estimates).
 // - Adaptive voxel filter: voxel_size, and for a sparse frame (delivered with fewer than 10 x
 //   min_downsampled_points points, e.g. FAST-LIO keyframes) that keeps fewer than
-//   min_downsampled_points, smaller voxels (halved at most twice).
+//   min_downsampled_points, smaller voxels (halved at most twice); for a frame that keeps more than
+//   max_downsampled_points, larger ones (one more pass over the kept points).
 
 #include <cstddef>
 #include <cstdint>
@@ -29,6 +30,7 @@ struct PreprocessOptions {
   double min_range = 0.3, max_range = 100.0;    ///< m
   double voxel_size = 0.25;                     ///< m (0: no filter)
   std::uint32_t min_downsampled_points = 1000;  ///< point floor of sparse frames (0: off)
+  std::uint32_t max_downsampled_points = 0;     ///< point ceiling of every frame (0: off)
   /// Keep rings and intensities (feature methods read them); otherwise only positions are kept.
   bool keep_attributes = true;
 };
@@ -60,8 +62,14 @@ bool sparse_frame(std::size_t delivered, const PreprocessOptions& options);
 
 /// The adaptive voxel filter alone: voxel_size, then, for a frame delivered with fewer than
 /// 10 x min_downsampled_points points (`delivered`, before the range crop), smaller voxels while
-/// fewer than min_downsampled_points remain (at most down to voxel_size / 4).
+/// fewer than min_downsampled_points remain (at most down to voxel_size / 4); then, above
+/// max_downsampled_points, thinned toward it (thin_to_points).
 PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
                                const PreprocessOptions& options);
+
+/// `cloud`, filtered with `voxel` (m), when it holds more than `max_points` (0: no limit): filtered
+/// again with a voxel sqrt(size / max_points) times larger, so that about max_points remain (the
+/// points of a scan lie on surfaces, whose voxel count falls with the voxel's square).
+PointCloud thin_to_points(PointCloud cloud, double voxel, std::size_t max_points);
 
 }  // namespace scanmatch
