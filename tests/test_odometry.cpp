@@ -282,6 +282,32 @@ TEST(Odometry, AStartInTheMiddleOfASlowingTurnKeepsItsHeading) {
   EXPECT_GT(worst_heading_error(run(without_redeskew(), s)), 3.0);
 }
 
+TEST(Odometry, TwoThreadsGiveTheSamePosesAndMap) {
+  // With two threads the map update and NDT grid of a frame run beside the next frame's
+  // preprocessing, and the stages' sums are split across threads: the poses and the map must be
+  // those of one thread (up to the order of floating-point sums).
+  const Sequence& s = simulated("dynamic-outdoor-fast", 300);
+  const std::size_t frames = sanitized() ? 15 : 60;
+  const auto run_with = [&](int threads, std::size_t& voxels) {
+    OdometryConfig c = with_method("ctf-icp");
+    c.threads = threads;
+    CtfIcpOdometry odometry(c);
+    std::vector<Pose> poses;
+    for (std::size_t i = 0; i < frames; ++i)
+      poses.push_back(odometry.register_frame(s.frames[i], s.times[i]));
+    voxels = odometry.map().size();
+    return poses;
+  };
+  std::size_t one_voxels = 0, two_voxels = 0;
+  const std::vector<Pose> one = run_with(1, one_voxels), two = run_with(2, two_voxels);
+  for (std::size_t i = 0; i < frames; ++i) {
+    const Pose d = one[i].inverse() * two[i];
+    EXPECT_LT(d.translation().norm(), 1e-6) << "frame " << i;
+    EXPECT_LT(rotation_angle(d), 1e-6) << "frame " << i;
+  }
+  EXPECT_EQ(one_voxels, two_voxels);
+}
+
 TEST(Odometry, MapMemoryStaysFlatWithASmallRadius) {
   const Sequence& s = simulated("dynamic-outdoor-fast", 300);
   OdometryConfig c = with_method("ctf-icp");

@@ -54,11 +54,28 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
 void CtfIcpOdometry::update_reference(PointCloud frame, const PointCloud& map_points,
                                       const Pose& pose, bool bridged, FrameStats& stats) {
   const Stopwatch map_time;
-  // Frames 0 and 1 build the map at once: frame 2 registers against both.
-  map_.add(map_points.empty() ? frame : map_points, pose, frames() <= 1);
+  wait_for_reference();
   if (frames() >= 1) first_frame_map_.reset();
-  coarse_.set_reference(std::move(frame), bridged);
-  stats.map_ms = map_time.ms();
+  // Frames 0 and 1 build the map at once: frame 2 registers against both.
+  const bool first = frames() <= 1;
+  if (config().threads > 1 && !first) {
+    // The map points are the pipeline's, reused by the next frame: the task keeps its own.
+    PointCloud points = map_points.empty() ? PointCloud{} : map_points;
+    reference_update_.work = std::async(
+        std::launch::async,
+        [this, frame = std::move(frame), points = std::move(points), pose, bridged]() mutable {
+          map_.add(points.empty() ? frame : points, pose, false);
+          coarse_.set_reference(std::move(frame), bridged);
+        });
+  } else {
+    map_.add(map_points.empty() ? frame : map_points, pose, first);
+    coarse_.set_reference(std::move(frame), bridged);
+  }
+  stats.map_ms += map_time.ms();
+}
+
+void CtfIcpOdometry::wait_for_reference() const {
+  if (reference_update_.work.valid()) reference_update_.work.get();
 }
 
 void CtfIcpOdometry::set_first_frame_detail(PointCloud detail) {
@@ -68,6 +85,7 @@ void CtfIcpOdometry::set_first_frame_detail(PointCloud detail) {
 }
 
 void CtfIcpOdometry::restart_reference(PointCloud first, const PointCloud& map_points) {
+  wait_for_reference();
   map_ = MapUpdate(config());
   map_.add(map_points.empty() ? first : map_points, Pose::Identity(), /*first=*/true);
   coarse_ = CoarseNdt(config());

@@ -7,6 +7,7 @@
 //   map_update.hpp    the global Gaussian map around the sensor
 // This file only chains them.
 
+#include <future>
 #include <optional>
 
 #include "scanmatch/odometry/coarse_ndt.hpp"
@@ -20,10 +21,16 @@ class CtfIcpOdometry final : public OdometryPipeline {
  public:
   /// Throws Error for invalid parameters.
   explicit CtfIcpOdometry(const OdometryConfig& config);
-  const PointCloud& last_frame() const override { return coarse_.reference(); }
+  const PointCloud& last_frame() const override {
+    wait_for_reference();
+    return coarse_.reference();
+  }
   /// The global Gaussian map, in the internal world frame (world_from_internal() * x gives the
   /// world frame of the returned poses).
-  const GaussianVoxelMap& map() const { return map_.map(); }
+  const GaussianVoxelMap& map() const {
+    wait_for_reference();
+    return map_.map();
+  }
 
  private:
   Pose estimate(const PointCloud& frame, const MotionPrior& prior, const Pose& predicted,
@@ -32,12 +39,26 @@ class CtfIcpOdometry final : public OdometryPipeline {
                         bool bridged, FrameStats& stats) override;
   void restart_reference(PointCloud first, const PointCloud& map_points) override;
   void set_first_frame_detail(PointCloud detail) override;
+  void finish_reference_update() override { wait_for_reference(); }
+  void wait_for_reference() const;
 
   CoarseNdt coarse_;
   FineStage fine_;
   MapUpdate map_;
   std::optional<MapUpdate> first_frame_map_;  ///< frame 0 at map density, for frame 1's fine stage
   bool fine_stage_;
+  /// Work still running; a copy of the pipeline (taken once it finished: map() waits) starts
+  /// with none.
+  struct Pending {
+    std::future<void> work;
+    Pending() = default;
+    Pending(const Pending&) {}
+    Pending& operator=(const Pending&) { return *this; }
+  };
+  /// With more than one thread, from frame 2 on, a frame's map update and NDT grid run beside
+  /// the reading and preprocessing of the next frame (same results: nothing there reads them).
+  /// Declared last: destroyed (joined) before what it writes.
+  mutable Pending reference_update_;
 };
 
 }  // namespace scanmatch

@@ -53,6 +53,9 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   if (frames_ == 0 && deskews_again_) set_first_frame_detail(frame_detail(frame, nullptr));
   stats_.points_downsampled = down.size();
   stats_.preprocess_ms = total.ms();
+  const Stopwatch waiting;
+  finish_reference_update();
+  stats_.map_ms = waiting.ms();  // the last frame's reference update, where this frame waited
 
   const bool redeskew = deskews_again_ && config_.deskew && timed_frames_ &&
                         (config_.redeskew_translation > 0.0 || config_.redeskew_rotation > 0.0);

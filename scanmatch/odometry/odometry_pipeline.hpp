@@ -62,6 +62,10 @@ class OdometryPipeline : public FrameOdometry {
   /// `map_points`: the frame at map density (Preprocessor::process), empty when `frame` serves.
   virtual void update_reference(PointCloud frame, const PointCloud& map_points, const Pose& pose,
                                 bool bridged, FrameStats& stats) = 0;
+  /// Waits for an update_reference still running beside the caller (a pipeline may run it on
+  /// another thread while the next frame is read and preprocessed); rethrows its exception.
+  /// Called before the next frame's estimate.
+  virtual void finish_reference_update() {}
   /// Forget every reference and start again from `first` (preprocessed, deskewed) as frame 0, at
   /// the internal origin: the first frame, deskewed once the first motion is measured.
   /// Only pipelines constructed with `deskews_again` are asked.
