@@ -41,7 +41,9 @@ void describe(Stats& s, Visitor& v) {
   v.stage("coarse_ms", s.coarse_ms, "coarse",
           "ctf-icp's coarse NDT stage, or the frame-to-frame registration, ms");
   v.stage("fine_ms", s.fine_ms, "fine", "ctf-icp's fine stage (frame to map), ms");
-  v.stage("map_ms", s.map_ms, "map_update", "ctf-icp's map update, ms");
+  v.stage("map_ms", s.map_ms, "map_update",
+          "ctf-icp's map update and NDT grid, ms (threads > 1: what the frame waited for the last "
+          "frame's, which runs beside its preprocessing, plus its own start)");
   v.stage("total_ms", s.total_ms, "total", "the whole frame (register_frame), ms");
   v("points_in", s.points_in, "points of the frame as given");
   v("points_downsampled", s.points_downsampled, "points left after the crops and voxel filter");
