@@ -425,6 +425,13 @@ MissedTurn avia_missed_turn() {
   return m;
 }
 
+// The coarse stage of configuration `c` on the missed turn.
+CoarseResult align_missed_turn(const MissedTurn& m, const OdometryConfig& c) {
+  CoarseNdt coarse(c);
+  coarse.set_reference(m.reference_frame, false);
+  return coarse.align(m.frame, m.prior);
+}
+
 }  // namespace
 
 TEST(AdaptiveRules, ATurnedStartRecoversAPriorThatMissedTheTurn) {
@@ -436,9 +443,7 @@ TEST(AdaptiveRules, ATurnedStartRecoversAPriorThatMissedTheTurn) {
   const auto align = [&](int rotation_starts) {
     OdometryConfig c;
     c.rotation_starts = rotation_starts;
-    CoarseNdt coarse(c);
-    coarse.set_reference(m.reference_frame, false);
-    return coarse.align(m.frame, m.prior);
+    return align_missed_turn(m, c);
   };
   const auto error_deg = [&](const CoarseResult& r) {
     return rotation_angle(truth.inverse() * r.motion) * kDegreesPerRadian;
@@ -461,9 +466,7 @@ TEST(AdaptiveRules, RankedStartsRecoverTheTurnWithFewerFullSolves) {
   const auto align = [&](std::uint32_t screen_points) {
     OdometryConfig c;
     c.start_screen_points = screen_points;
-    CoarseNdt coarse(c);
-    coarse.set_reference(m.reference_frame, false);
-    return coarse.align(m.frame, m.prior);
+    return align_missed_turn(m, c);
   };
   const CoarseResult ranked = align(150);
   const CoarseResult every = align(0);
@@ -492,9 +495,7 @@ TEST(AdaptiveRules, AThinnedWideDescentRecoversTheSameTurn) {
   const auto align = [&](double start_voxel_size) {
     OdometryConfig c;
     c.start_voxel_size = start_voxel_size;
-    CoarseNdt coarse(c);
-    coarse.set_reference(m.reference_frame, false);
-    return coarse.align(m.frame, m.prior);
+    return align_missed_turn(m, c);
   };
   const CoarseResult thinned = align(OdometryConfig{}.start_voxel_size);
   const CoarseResult every = align(0.0);

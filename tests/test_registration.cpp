@@ -92,28 +92,40 @@ TEST(Solver, PointJacobianMatchesNumericalDerivative) {
   }
 }
 
-TEST(Solver, ExactCorrespondencesConvergeImmediately) {
-  // Point-to-point with exact correspondences and a small motion: Gauss-Newton lands on the truth.
-  PointCloud target;
-  std::mt19937 rng(3);
+namespace {
+
+// Point-to-point with exact correspondences: source i is target i moved by truth^-1.
+struct ExactPairs {
+  const PointCloud& s;
+  const PointCloud& t;
+  std::size_t size() const { return s.size(); }
+  bool linearize(const Pose& T, std::size_t i, LinearSystem& sys, const RobustKernel& k) const {
+    const Eigen::Vector3d p = s.points[i].cast<double>();
+    sys.add<3>(point_jacobian(T, p), T * p - t.points[i].cast<double>(),
+               Eigen::Matrix3d::Identity(), k);
+    return true;
+  }
+};
+
+// 300 random points in a 10 m cube (`seed`), and the same points moved by truth^-1.
+std::pair<PointCloud, PointCloud> exact_clouds(unsigned seed, const Pose& truth) {
+  PointCloud target, source;
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(-5, 5);
   for (int i = 0; i < 300; ++i) target.points.emplace_back(u(rng), u(rng), u(rng));
-  const Pose truth = from_xyz_rpy(0.05, -0.03, 0.02, 0.01, 0.02, -0.015);
-  PointCloud source;
   for (const Point& q : target.points)
     source.points.push_back((truth.inverse() * q.cast<double>()).cast<float>());
-  struct Exact {
-    const PointCloud& s;
-    const PointCloud& t;
-    std::size_t size() const { return s.size(); }
-    bool linearize(const Pose& T, std::size_t i, LinearSystem& sys, const RobustKernel& k) const {
-      const Eigen::Vector3d p = s.points[i].cast<double>();
-      sys.add<3>(point_jacobian(T, p), T * p - t.points[i].cast<double>(),
-                 Eigen::Matrix3d::Identity(), k);
-      return true;
-    }
-  };
-  const RegistrationResult r = optimize(Exact{source, target}, Pose::Identity(), SolverOptions{});
+  return {source, target};
+}
+
+}  // namespace
+
+TEST(Solver, ExactCorrespondencesConvergeImmediately) {
+  // Exact correspondences and a small motion: Gauss-Newton lands on the truth.
+  const Pose truth = from_xyz_rpy(0.05, -0.03, 0.02, 0.01, 0.02, -0.015);
+  const auto [source, target] = exact_clouds(3, truth);
+  const RegistrationResult r =
+      optimize(ExactPairs{source, target}, Pose::Identity(), SolverOptions{});
   EXPECT_TRUE(r.converged);
   EXPECT_LE(r.iterations, 4);
   EXPECT_TRUE(r.transform.isApprox(truth, 1e-6));
@@ -122,26 +134,9 @@ TEST(Solver, ExactCorrespondencesConvergeImmediately) {
 TEST(Solver, ACallersStopEndsTheSolveWhereItSays) {
   // A large rotation takes Gauss-Newton several steps; a caller that knows where the descent
   // leads (as the coarse stage does for a start reaching another start's optimum) ends it there.
-  PointCloud target;
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> u(-5, 5);
-  for (int i = 0; i < 300; ++i) target.points.emplace_back(u(rng), u(rng), u(rng));
   const Pose truth = from_xyz_rpy(1.0, -0.5, 0.2, 0.3, -0.2, 0.9);
-  PointCloud source;
-  for (const Point& q : target.points)
-    source.points.push_back((truth.inverse() * q.cast<double>()).cast<float>());
-  struct Exact {
-    const PointCloud& s;
-    const PointCloud& t;
-    std::size_t size() const { return s.size(); }
-    bool linearize(const Pose& T, std::size_t i, LinearSystem& sys, const RobustKernel& k) const {
-      const Eigen::Vector3d p = s.points[i].cast<double>();
-      sys.add<3>(point_jacobian(T, p), T * p - t.points[i].cast<double>(),
-                 Eigen::Matrix3d::Identity(), k);
-      return true;
-    }
-  };
-  const Exact factor{source, target};
+  const auto [source, target] = exact_clouds(5, truth);
+  const ExactPairs factor{source, target};
   const RegistrationResult full = optimize(factor, Pose::Identity(), SolverOptions{});
   ASSERT_TRUE(full.converged);
   ASSERT_GE(full.iterations, 3);
