@@ -21,6 +21,8 @@
 #include "scanmatch/io/trajectory.hpp"
 #include "scanmatch/mapping/loop_closure3d.hpp"
 #include "scanmatch/mapping/loop_verification3d.hpp"
+#include "scanmatch/registration/methods.hpp"
+#include "scanmatch/registration/prepared_cloud.hpp"
 #include "scanmatch/run/odometry_run.hpp"
 #include "scanmatch/sim/scene.hpp"
 #include "scanmatch/sim/sensor.hpp"
@@ -135,6 +137,102 @@ TEST(LoopClosure3D, VerificationRejectsAWrongCandidate) {
     const LoopVerification3D v = verify_loop_3d(there, here, guess, verification);
     EXPECT_FALSE(v.accepted) << v.overlap << " " << v.error << " " << v.constraint;
   }
+}
+
+TEST(LoopClosure3D, PreparedSubmapsRegisterAndVerifyAsTheGenericPath) {
+  sim::SimOptions options;
+  options.preset = "dynamic-outdoor-fast";
+  options.frames = 30;
+  const SimulatedFrames frames = simulate(options, 1);
+  const PointCloud &here = frames.clouds[10], &near = frames.clouds[14], &far = frames.clouds[29];
+  PreparedCloud prepared_here(here), prepared_near(near), prepared_far(far);
+  // Each method twice: the second registration reads what the first built. point-to-plane is not
+  // prepared: register_prepared runs register_clouds for it.
+  const Pose guess = from_xyz_rpy(0.3, -0.2, 0.05, 0, 0, 0.05);
+  for (const std::string method : {"ndt", "gicp", "point-to-plane"}) {
+    RegistrationOptions o;
+    o.method = method;
+    o.voxel_resolution = 2.0;
+    const RegistrationResult generic = register_clouds(near, here, o, guess);
+    for (int round = 0; round < 2; ++round) {
+      const RegistrationResult prepared = register_prepared(prepared_near, prepared_here, o, guess);
+      EXPECT_EQ(prepared.transform.matrix(), generic.transform.matrix()) << method << round;
+      EXPECT_EQ(prepared.iterations, generic.iterations) << method << round;
+      EXPECT_EQ(prepared.information, generic.information) << method << round;
+    }
+  }
+  EXPECT_THROW(register_prepared(
+                   prepared_near, prepared_here,
+                   [] {
+                     RegistrationOptions o;
+                     o.method = "no-such-method";
+                     return o;
+                   }(),
+                   guess),
+               Error);
+  // Verification: a keyframe against two others in turn, then again, as loop closure does.
+  const LoopVerification3DOptions verification;
+  const auto expect_same = [](const LoopVerification3D& a, const LoopVerification3D& b) {
+    EXPECT_EQ(a.accepted, b.accepted);
+    EXPECT_EQ(a.prechecked_out, b.prechecked_out);
+    EXPECT_EQ(a.transform.matrix(), b.transform.matrix());
+    EXPECT_EQ(a.overlap, b.overlap);
+    EXPECT_EQ(a.error, b.error);
+    EXPECT_EQ(a.constraint, b.constraint);
+    EXPECT_EQ(a.hessian, b.hessian);
+  };
+  const LoopVerification3D generic_near = verify_loop_3d(here, near, guess, verification);
+  const LoopVerification3D generic_far = verify_loop_3d(here, far, guess, verification);
+  EXPECT_TRUE(generic_near.accepted);  // so that the comparison covers every stage
+  const std::size_t unprepared = prepared_far.memory_bytes();
+  for (int round = 0; round < 2; ++round) {
+    expect_same(verify_loop_3d(prepared_here, prepared_near, guess, verification), generic_near);
+    expect_same(verify_loop_3d(prepared_here, prepared_far, guess, verification), generic_far);
+  }
+  EXPECT_GT(prepared_far.memory_bytes(), unprepared);  // it kept what was built
+}
+
+TEST(LoopClosure3D, VerificationMemoryStaysWithinItsBudgetWithTheSameLoops) {
+  // Out along a street and back: the way back revisits every keyframe of the way out.
+  sim::SimOptions options;
+  options.preset = "dynamic-outdoor-fast";
+  options.frames = 50;
+  const SimulatedFrames frames = simulate(options, 1);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < frames.clouds.size(); ++i) order.push_back(i);
+  for (std::size_t i = frames.clouds.size(); i-- > 0;) order.push_back(i);
+  const auto run = [&](double memory_mb) {
+    LoopClosure3DOptions o;
+    o.skip_recent = 8;
+    o.verification_memory_mb = memory_mb;
+    auto loops = std::make_unique<LoopClosure3D>(o);
+    for (const std::size_t i : order) {
+      loops->add_frame(frames.clouds[i], frames.truth[i]);
+      EXPECT_LE(static_cast<double>(loops->verification_memory_bytes()), memory_mb * 1024 * 1024);
+    }
+    loops->finish();
+    return loops;
+  };
+  const auto unbounded = run(1000.0), small = run(2.5), none = run(0.0);
+  ASSERT_GT(unbounded->loops().size(), 2u);
+  for (const LoopClosure3D* other : {small.get(), none.get()}) {
+    ASSERT_EQ(other->loops().size(), unbounded->loops().size());
+    for (std::size_t i = 0; i < unbounded->loops().size(); ++i) {
+      EXPECT_EQ(other->loops()[i].from_frame, unbounded->loops()[i].from_frame);
+      EXPECT_EQ(other->loops()[i].relative.matrix(), unbounded->loops()[i].relative.matrix());
+    }
+    EXPECT_EQ(other->counts().candidates, unbounded->counts().candidates);
+  }
+  // Kept submaps are verified again without being rebuilt (each loop's two submaps were
+  // prepared only once: here the way back's keyframes verify against the way out's, which had
+  // verified nothing); a smaller budget rebuilds some, none keeps none from one keyframe to the
+  // next.
+  EXPECT_LE(unbounded->counts().submaps_prepared, unbounded->counts().candidates);
+  EXPECT_GT(unbounded->verification_memory_bytes(), 2u * 1024u * 1024u);
+  EXPECT_GE(small->counts().submaps_prepared, unbounded->counts().submaps_prepared);
+  EXPECT_GT(none->counts().submaps_prepared, unbounded->counts().submaps_prepared);
+  EXPECT_GE(none->counts().submaps_prepared, small->counts().submaps_prepared);
+  EXPECT_EQ(none->verification_memory_bytes(), 0u);
 }
 
 TEST(LoopClosure3D, BadInputIsRejectedNotFatal) {

@@ -44,6 +44,8 @@ LoopClosure3D::LoopClosure3D(const LoopClosure3DOptions& options)
     throw Error("loop closure: submap voxel, pair distance and coarse resolution must be positive");
   if (!(options.keyframe_distance >= 0.0) || !(options.keyframe_angle >= 0.0))
     throw Error("loop closure: keyframe thresholds must not be negative");
+  if (!(options.verification_memory_mb >= 0.0))
+    throw Error("loop closure: the verification memory must not be negative");
   options_.search_every = std::max<std::size_t>(options_.search_every, 1);
   options_.submap_frames = std::max<std::size_t>(options_.submap_frames, 1);
 }
@@ -140,10 +142,12 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
     const Pose initial = candidate.by_descriptor ? from_xyz_rpy(0, 0, 0, 0, 0, candidate.yaw)
                                                  : orthonormalized(estimated);
     const double allowed = correction_allowed(keyframe, k);
-    const LoopVerification3D v = verify_loop_3d(keyframes_[keyframe].submap, keyframes_[k].submap,
-                                                initial, options_.verification);
+    const LoopVerification3D v =
+        verify_loop_3d(prepared(keyframe), prepared(k), initial, options_.verification);
+    trim_prepared(keyframe);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
+      counts_.prechecked_out += v.prechecked_out;
       continue;
     }
     if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
@@ -163,9 +167,44 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
                                               options_.loop_sigma_rotation));
     added = true;
   }
+  trim_prepared(kNoKeyframe);
   if (added) {
     last_loop_keyframe_ = keyframe;
     optimize();
+  }
+}
+
+PreparedCloud& LoopClosure3D::prepared(std::size_t keyframe) {
+  std::unique_ptr<PreparedCloud>& p = keyframes_[keyframe].prepared;
+  if (p) {
+    prepared_order_.remove(keyframe);
+  } else {
+    p = std::make_unique<PreparedCloud>(keyframes_[keyframe].submap);
+    ++counts_.submaps_prepared;
+  }
+  prepared_order_.push_front(keyframe);
+  return *p;
+}
+
+std::size_t LoopClosure3D::verification_memory_bytes() const {
+  std::size_t bytes = 0;
+  for (const std::size_t k : prepared_order_) bytes += keyframes_[k].prepared->memory_bytes();
+  return bytes;
+}
+
+void LoopClosure3D::trim_prepared(std::size_t keep) {
+  const double budget = options_.verification_memory_mb * 1024.0 * 1024.0;
+  double bytes = 0.0;
+  for (auto it = prepared_order_.begin(); it != prepared_order_.end();) {
+    std::unique_ptr<PreparedCloud>& p = keyframes_[*it].prepared;
+    bytes += static_cast<double>(p->memory_bytes());
+    if (bytes <= budget || *it == keep) {
+      ++it;
+      continue;
+    }
+    bytes -= static_cast<double>(p->memory_bytes());
+    p.reset();
+    it = prepared_order_.erase(it);
   }
 }
 

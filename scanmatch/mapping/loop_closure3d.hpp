@@ -20,6 +20,8 @@
 #include <cmath>
 #include <cstddef>
 #include <deque>
+#include <list>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,7 @@
 #include "scanmatch/mapping/loop_candidates.hpp"
 #include "scanmatch/mapping/loop_verification3d.hpp"
 #include "scanmatch/mapping/pose_graph.hpp"
+#include "scanmatch/registration/prepared_cloud.hpp"
 
 namespace scanmatch {
 
@@ -89,6 +92,12 @@ struct LoopClosure3DOptions {
   /// as one per keyframe at a fraction of the verification cost (0: no pause).
   std::size_t keyframes_between_loops = 4;
   LoopVerification3DOptions verification;
+  /// What verification builds from a keyframe's submap (the coarse method's voxel map, k-d tree,
+  /// the fine method's covariances, normals: 0.25-2 MB a keyframe) is kept for its next
+  /// verifications, the current keyframe's against each candidate and an old keyframe's at every
+  /// revisit, up to this many MB; the least recently verified are dropped first (0: the current
+  /// keyframe's are kept for its other candidates only). The results are the same either way.
+  double verification_memory_mb = 64.0;
   PlaceDescriptorOptions descriptor;
   PoseGraphConfig graph;
 };
@@ -107,6 +116,11 @@ struct LoopClosure3DCounts {
   std::size_t candidates = 0;  ///< candidate pairs proposed (after merging both sources)
   std::size_t verified = 0;    ///< candidates that passed every check (loop edges added)
   std::size_t rejected_by_verification = 0;
+  /// Of those, rejected by verification's pre-check before the fine stage.
+  std::size_t prechecked_out = 0;
+  /// Keyframe submaps whose verification structures were built (again, when the memory budget
+  /// had dropped them): the verification cache's misses.
+  std::size_t submaps_prepared = 0;
   /// Verified but too far from the current estimate (max_correction): not added.
   std::size_t rejected_by_estimate = 0;
   /// Place-database matches ruled out before verification (registration_reach); not candidates.
@@ -141,6 +155,9 @@ class LoopClosure3D {
   /// Keyframe `k`'s submap (in its frame), as verification saw it.
   const PointCloud& submap(std::size_t keyframe) const { return keyframes_.at(keyframe).submap; }
   std::size_t keyframes() const { return keyframes_.size(); }
+  /// Bytes the verification structures kept between keyframes hold (at most
+  /// verification_memory_mb once add_frame() returns).
+  std::size_t verification_memory_bytes() const;
   /// The keyframe frame `index` belongs to (the last keyframe at or before it), and the frame's
   /// odometry pose in that keyframe's frame: pose(index) == graph().pose(keyframe) * offset.
   std::size_t keyframe_of(std::size_t index) const { return graph_.keyframe_of(index); }
@@ -152,6 +169,8 @@ class LoopClosure3D {
   struct Keyframe {
     std::size_t frame = 0;
     PointCloud submap;
+    /// The submap with what verification built from it, while kept (verification_memory_mb).
+    std::unique_ptr<PreparedCloud> prepared;
     Pose odometry = Pose::Identity();
     double path = 0.0;  ///< m of odometry travel since the first keyframe
   };
@@ -163,6 +182,12 @@ class LoopClosure3D {
   /// frame_voxel_.
   PointCloud build_submap(const Pose& keyframe_odometry);
   void close_loops(std::size_t keyframe);
+  /// Keyframe k's prepared submap, built when not kept; now the most recently used.
+  PreparedCloud& prepared(std::size_t keyframe);
+  static constexpr std::size_t kNoKeyframe = static_cast<std::size_t>(-1);
+  /// Drops the least recently used prepared submaps, except keyframe `keep`'s, until the rest fit
+  /// verification_memory_mb.
+  void trim_prepared(std::size_t keep);
   void optimize();
   /// The estimate gate (m) between a keyframe and an older candidate.
   double correction_allowed(std::size_t keyframe, std::size_t candidate) const;
@@ -172,6 +197,7 @@ class LoopClosure3D {
   PlaceDatabase3D places_;
   std::vector<Keyframe> keyframes_;
   std::deque<RecentFrame> recent_;
+  std::list<std::size_t> prepared_order_;  ///< keyframes with a prepared submap, most recent first
   double frame_voxel_ = 0.0;  ///< m, the voxel new frames are kept at (submap_voxel or coarser)
   std::size_t last_loop_keyframe_ = 0;  ///< the last keyframe that added a loop edge
   LoopClosure3DCounts counts_;

@@ -48,6 +48,10 @@ template <typename Counts, typename Visitor>
 requires std::same_as<std::remove_const_t<Counts>, LoopClosure3DCounts>
 void describe(Counts& c, Visitor& v) {
   loop_counts_detail::describe_shared(c, v);
+  v("prechecked_out", c.prechecked_out,
+    "of rejected_by_verification, those its pre-check rejected before the fine stage");
+  v("submaps_prepared", c.submaps_prepared,
+    "keyframe submaps whose verification structures were built (the cache's misses)");
   v("ruled_out_by_estimate", c.ruled_out_by_estimate,
     "place-database matches ruled out before verification (registration_reach); not candidates");
   v("total_ms", c.total_ms, "wall time spent in add_frame() and finish(), ms");

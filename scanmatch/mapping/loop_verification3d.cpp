@@ -7,10 +7,8 @@
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
-#include "scanmatch/geometry/covariance.hpp"
 #include "scanmatch/geometry/kdtree.hpp"
 #include "scanmatch/geometry/voxel_hash.hpp"
-#include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
 namespace {
@@ -92,6 +90,14 @@ Matrix6d to_graph_order(const Matrix6d& H) {
 
 LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& candidate,
                                   const Pose& initial, const LoopVerification3DOptions& options) {
+  PreparedCloud prepared_current(current), prepared_candidate(candidate);
+  return verify_loop_3d(prepared_current, prepared_candidate, initial, options);
+}
+
+LoopVerification3D verify_loop_3d(PreparedCloud& prepared_current,
+                                  PreparedCloud& prepared_candidate, const Pose& initial,
+                                  const LoopVerification3DOptions& options) {
+  const PointCloud &current = prepared_current.cloud(), &candidate = prepared_candidate.cloud();
   LoopVerification3D out;
   out.transform = initial;
   const std::size_t min_points = std::max<std::size_t>(options.min_points, kNormalNeighbours + 1);
@@ -108,7 +114,8 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
   fine.solver.max_iterations = options.max_iterations;
   RegistrationResult result;
   try {
-    const Pose start = register_clouds(current, candidate, coarse, initial).transform;
+    const Pose start =
+        register_prepared(prepared_current, prepared_candidate, coarse, initial).transform;
     if (!is_valid_pose(start.matrix(), 1e-6)) return out;
     // Before the fine stage (four fifths of a verification): a candidate whose submaps do not
     // even share coarse cells at the coarse pose is not expected to reach min_overlap of points
@@ -123,7 +130,7 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
       out.prechecked_out = true;
       return out;
     }
-    result = register_clouds(current, candidate, fine, start);
+    result = register_prepared(prepared_current, prepared_candidate, fine, start);
   } catch (const Error&) {
     return out;  // too few usable points for a method: not verifiable, so not a loop
   }
@@ -131,17 +138,12 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
   out.transform = result.transform;
   if (result.information.allFinite()) out.hessian = to_graph_order(result.information);
 
-  const KdTree current_tree(current.points), candidate_tree(candidate.points);
-  const std::vector<Eigen::Vector3d> current_normals =
-      estimate_normals(current, current_tree, kNormalNeighbours);
-  const std::vector<Eigen::Vector3d> candidate_normals =
-      estimate_normals(candidate, candidate_tree, kNormalNeighbours);
-  const OverlapCheck forward =
-      check_overlap(current, candidate, candidate_tree, candidate_normals, out.transform,
-                    options.pair_distance, options.plane_distance);
-  OverlapCheck backward =
-      check_overlap(candidate, current, current_tree, current_normals, out.transform.inverse(),
-                    options.pair_distance, options.plane_distance);
+  const OverlapCheck forward = check_overlap(
+      current, candidate, prepared_candidate.tree(), prepared_candidate.normals(kNormalNeighbours),
+      out.transform, options.pair_distance, options.plane_distance);
+  OverlapCheck backward = check_overlap(
+      candidate, current, prepared_current.tree(), prepared_current.normals(kNormalNeighbours),
+      out.transform.inverse(), options.pair_distance, options.plane_distance);
   // Both in the candidate's frame, so that the two ways' normals add up.
   const Eigen::Matrix3d R = out.transform.linear();
   backward.normals = R * backward.normals * R.transpose();

@@ -11,6 +11,7 @@
 #include "scanmatch/core/point_cloud.hpp"
 #include "scanmatch/core/se3.hpp"
 #include "scanmatch/mapping/loop_verification.hpp"
+#include "scanmatch/registration/prepared_cloud.hpp"
 
 namespace scanmatch {
 
@@ -61,6 +62,11 @@ struct LoopVerification3D {
 /// place, starting from `initial` (current in the candidate's frame). Never throws for bad clouds
 /// (too few or non-finite points) or failed registrations: rejects.
 LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& candidate,
+                                  const Pose& initial, const LoopVerification3DOptions& options);
+/// The same with the submaps' structures (the coarse method's voxel map, k-d trees, the fine
+/// method's covariances, normals) kept in `current` and `candidate`: built on first use and reused
+/// by later verifications of either submap, with the same result.
+LoopVerification3D verify_loop_3d(PreparedCloud& current, PreparedCloud& candidate,
                                   const Pose& initial, const LoopVerification3DOptions& options);
 
 }  // namespace scanmatch

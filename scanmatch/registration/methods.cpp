@@ -19,26 +19,8 @@ namespace {
 
 using Options = RegistrationOptions;
 
-GaussianVoxelMap target_map(const PointCloud& target, const Options& o) {
-  GaussianVoxelMapOptions m;
-  m.voxel_size = o.voxel_resolution;
-  m.planar_epsilon = o.ctf_epsilon;
-  GaussianVoxelMap map(m);
-  map.insert(target);
-  return map;
-}
-
 int voxel_neighbours(const Options& o, int method_default) {
   return o.voxel_neighbours > 0 ? o.voxel_neighbours : method_default;
-}
-
-std::vector<Eigen::Matrix3d> regularised_covariances(const PointCloud& cloud, const KdTree& tree,
-                                                     const Options& o) {
-  std::vector<Eigen::Matrix3d> covariances =
-      estimate_covariances(cloud, tree, o.covariance_neighbours, o.solver.num_threads);
-  // Segal's plane regularisation: eigenvalues (1, 1, eps).
-  for (auto& C : covariances) C = planar_covariance(C, o.gicp_epsilon);
-  return covariances;
 }
 
 // Metric covariances with floored eigenvalues, on the same scale as the voxels' Gaussians.
@@ -85,12 +67,9 @@ RegistrationResult point_to_line(const PointCloud& s, const PointCloud& t, const
 
 RegistrationResult gicp(const PointCloud& s, const PointCloud& t, const Options& o, const Pose& T) {
   const KdTree target_tree(t.points), source_tree(s.points);
-  const auto target_covariances = regularised_covariances(t, target_tree, o);
-  const auto source_covariances = regularised_covariances(s, source_tree, o);
-  return optimize(GicpFactor{{s, t, target_tree, o.max_correspondence_distance},
-                             source_covariances,
-                             target_covariances},
-                  T, o.solver);
+  const auto target_covariances = gicp_covariances(t, target_tree, o);
+  const auto source_covariances = gicp_covariances(s, source_tree, o);
+  return gicp_on({s, source_tree, source_covariances}, {t, target_tree, target_covariances}, o, T);
 }
 
 RegistrationResult vgicp(const PointCloud& s, const PointCloud& t, const Options& o,
@@ -99,18 +78,17 @@ RegistrationResult vgicp(const PointCloud& s, const PointCloud& t, const Options
   auto source_covariances =
       estimate_covariances(s, source_tree, o.covariance_neighbours, o.solver.num_threads);
   for (auto& C : source_covariances) C = floored_covariance(C);
-  const GaussianVoxelMap map = target_map(t, o);
+  const GaussianVoxelMap map = registration_voxel_map(t, o);
   return optimize(VgicpFactor{s, source_covariances, map, voxel_neighbours(o, 1)}, T, o.solver);
 }
 
 RegistrationResult ndt(const PointCloud& s, const PointCloud& t, const Options& o, const Pose& T) {
-  const GaussianVoxelMap map = target_map(t, o);
-  return optimize(ndt_factor(s, map, voxel_neighbours(o, 7), o.ndt_outlier_ratio), T, o.solver);
+  return ndt_on_map(s, registration_voxel_map(t, o), o, T);
 }
 
 RegistrationResult ctf_fine(const PointCloud& s, const PointCloud& t, const Options& o,
                             const Pose& T) {
-  const GaussianVoxelMap map = target_map(t, o);
+  const GaussianVoxelMap map = registration_voxel_map(t, o);
   CtfFineOptions fine;
   fine.max_iterations = o.solver.max_iterations;
   fine.tolerance = o.solver.translation_tolerance;
@@ -207,14 +185,51 @@ std::size_t minimum_points(const std::string& method, const RegistrationOptions&
 
 RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target,
                                    const RegistrationOptions& o, const Pose& initial) {
-  const RegistrationMethod& method = find_registration_method(o.method);
-  const std::size_t need = method.minimum_points(o);
-  if (source.size() < need || target.size() < need)
+  check_registration_inputs(source.size(), target.size(), o, initial);
+  return find_registration_method(o.method).run(source, target, o, initial);
+}
+
+void check_registration_inputs(std::size_t source_points, std::size_t target_points,
+                               const RegistrationOptions& o, const Pose& initial) {
+  const std::size_t need = minimum_points(o.method, o);
+  if (source_points < need || target_points < need)
     throw Error(o.method + " needs at least " + std::to_string(need) +
-                " points in each cloud (source has " + std::to_string(source.size()) + ", target " +
-                std::to_string(target.size()) + ")");
+                " points in each cloud (source has " + std::to_string(source_points) + ", target " +
+                std::to_string(target_points) + ")");
   if (!to_matrix(initial).allFinite()) throw Error("the initial guess is not finite");
-  return method.run(source, target, o, initial);
+}
+
+GaussianVoxelMap registration_voxel_map(const PointCloud& cloud, const RegistrationOptions& o) {
+  GaussianVoxelMapOptions m;
+  m.voxel_size = o.voxel_resolution;
+  m.planar_epsilon = o.ctf_epsilon;
+  GaussianVoxelMap map(m);
+  map.insert(cloud);
+  return map;
+}
+
+std::vector<Eigen::Matrix3d> gicp_covariances(const PointCloud& cloud, const KdTree& tree,
+                                              const RegistrationOptions& o) {
+  std::vector<Eigen::Matrix3d> covariances =
+      estimate_covariances(cloud, tree, o.covariance_neighbours, o.solver.num_threads);
+  // Segal's plane regularisation: eigenvalues (1, 1, eps).
+  for (auto& C : covariances) C = planar_covariance(C, o.gicp_epsilon);
+  return covariances;
+}
+
+RegistrationResult ndt_on_map(const PointCloud& source, const GaussianVoxelMap& target_map,
+                              const RegistrationOptions& o, const Pose& initial) {
+  return optimize(ndt_factor(source, target_map, voxel_neighbours(o, 7), o.ndt_outlier_ratio),
+                  initial, o.solver);
+}
+
+RegistrationResult gicp_on(const GicpCloud& source, const GicpCloud& target,
+                           const RegistrationOptions& o, const Pose& initial) {
+  return optimize(
+      GicpFactor{{source.cloud, target.cloud, target.tree, o.max_correspondence_distance},
+                 source.covariances,
+                 target.covariances},
+      initial, o.solver);
 }
 
 double fitness_score(const PointCloud& source, const PointCloud& target, const Pose& T,
