@@ -114,8 +114,13 @@ LoopVerification3D verify_loop_3d(PreparedCloud& prepared_current,
   fine.solver.max_iterations = options.max_iterations;
   RegistrationResult result;
   try {
+    PreparedCloud* coarse_source = &prepared_current;
+    if (options.coarse_source_voxel > 0.0) {
+      PreparedCloud& sparse = prepared_current.downsampled(options.coarse_source_voxel);
+      if (sparse.size() >= min_points) coarse_source = &sparse;
+    }
     const Pose start =
-        register_prepared(prepared_current, prepared_candidate, coarse, initial).transform;
+        register_prepared(*coarse_source, prepared_candidate, coarse, initial).transform;
     if (!is_valid_pose(start.matrix(), 1e-6)) return out;
     // Before the fine stage (four fifths of a verification): a candidate whose submaps do not
     // even share coarse cells at the coarse pose is not expected to reach min_overlap of points

@@ -29,6 +29,9 @@ struct LoopVerification3DOptions : LoopVerificationOptions {
   /// translation at all).
   std::string coarse_method = "ndt";
   double coarse_resolution = 2.0;  ///< m, the coarse method's voxel grid
+  /// The coarse stage registers the current submap downsampled to this voxel (m; 0: every point):
+  /// a 2 m grid's Gaussians need no more than a point per metre to pull.
+  double coarse_source_voxel = 0.5;
   /// Fine stage: a point-based method from the coarse result.
   std::string fine_method = "gicp";
   double fine_max_correspondence_distance = 1.0;  ///< m

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "scanmatch/geometry/covariance.hpp"
+#include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/registration/methods.hpp"
 
 namespace scanmatch {
@@ -51,12 +52,21 @@ const GaussianVoxelMap& PreparedCloud::voxel_map(const RegistrationOptions& opti
   return *map_;
 }
 
+PreparedCloud& PreparedCloud::downsampled(double voxel) {
+  if (!downsampled_ || downsampled_voxel_ != voxel) {
+    downsampled_ = std::make_unique<PreparedCloud>(voxel_downsample(cloud_, voxel));
+    downsampled_voxel_ = voxel;
+  }
+  return *downsampled_;
+}
+
 std::size_t PreparedCloud::memory_bytes() const {
   std::size_t bytes = sizeof(*this) + cloud_.points.capacity() * sizeof(Point);
   if (tree_) bytes += cloud_.size() * kTreeBytesPerPoint;
   bytes += covariances_.capacity() * sizeof(Eigen::Matrix3d);
   bytes += normals_.capacity() * sizeof(Eigen::Vector3d);
   if (map_) bytes += map_->size() * kVoxelBytes;
+  if (downsampled_) bytes += downsampled_->memory_bytes();
   return bytes;
 }
 

@@ -40,6 +40,10 @@ class PreparedCloud {
   /// rebuilt for other values.
   const GaussianVoxelMap& voxel_map(const RegistrationOptions& options);
 
+  /// The cloud downsampled to `voxel` m (voxel_downsample's centroids), itself prepared; kept
+  /// for one voxel size, rebuilt for another.
+  PreparedCloud& downsampled(double voxel);
+
   /// Approximate bytes held (the cloud and what has been built).
   std::size_t memory_bytes() const;
 
@@ -53,6 +57,8 @@ class PreparedCloud {
   int normal_neighbours_ = 0;
   std::unique_ptr<GaussianVoxelMap> map_;
   double map_resolution_ = 0.0, map_epsilon_ = 0.0;
+  std::unique_ptr<PreparedCloud> downsampled_;
+  double downsampled_voxel_ = 0.0;
 };
 
 /// register_clouds(source.cloud(), target.cloud(), options, initial), the same result, with the
