@@ -139,6 +139,9 @@ TEST(LoopClosure3D, VerificationRejectsAWrongCandidate) {
   }
 }
 
+// Registering and verifying with prepared submaps (kept structures, loop closure's cache) gives
+// the generic path's results, bit for bit; an estimate's expectation only rejects early what it
+// rules out.
 TEST(LoopClosure3D, PreparedSubmapsRegisterAndVerifyAsTheGenericPath) {
   sim::SimOptions options;
   options.preset = "dynamic-outdoor-fast";
@@ -190,8 +193,21 @@ TEST(LoopClosure3D, PreparedSubmapsRegisterAndVerifyAsTheGenericPath) {
     expect_same(verify_loop_3d(prepared_here, prepared_far, guess, verification), generic_far);
   }
   EXPECT_GT(prepared_far.memory_bytes(), unprepared);  // it kept what was built
+  // An estimate that expects the loop where it is changes nothing; one 10 m away rejects it
+  // before the fine stage.
+  const Eigen::Vector3d found = generic_near.transform.translation();
+  expect_same(verify_loop_3d(prepared_here, prepared_near, guess, verification,
+                             LoopExpectation{found + Eigen::Vector3d(0.5, 0, 0), 1.0}),
+              generic_near);
+  const LoopVerification3D elsewhere =
+      verify_loop_3d(prepared_here, prepared_near, guess, verification,
+                     LoopExpectation{found + Eigen::Vector3d(10, 0, 0), 1.0});
+  EXPECT_FALSE(elsewhere.accepted);
+  EXPECT_TRUE(elsewhere.prechecked_out && elsewhere.beyond_expectation);
 }
 
+// verification_memory_mb bounds what loop closure keeps of its submaps' structures, and only the
+// time changes with it.
 TEST(LoopClosure3D, VerificationMemoryStaysWithinItsBudgetWithTheSameLoops) {
   // Out along a street and back: the way back revisits every keyframe of the way out.
   sim::SimOptions options;

@@ -143,11 +143,13 @@ void LoopClosure3D::close_loops(std::size_t keyframe) {
                                                  : orthonormalized(estimated);
     const double allowed = correction_allowed(keyframe, k);
     const LoopVerification3D v =
-        verify_loop_3d(prepared(keyframe), prepared(k), initial, options_.verification);
+        verify_loop_3d(prepared(keyframe), prepared(k), initial, options_.verification,
+                       LoopExpectation{estimated.translation(), allowed});
     trim_prepared(keyframe);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       counts_.prechecked_out += v.prechecked_out;
+      counts_.beyond_estimate_before_fine += v.beyond_expectation;
       continue;
     }
     if ((estimated.translation() - v.transform.translation()).norm() > allowed) {

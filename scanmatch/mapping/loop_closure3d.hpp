@@ -118,6 +118,8 @@ struct LoopClosure3DCounts {
   std::size_t rejected_by_verification = 0;
   /// Of those, rejected by verification's pre-check before the fine stage.
   std::size_t prechecked_out = 0;
+  /// Of those, rejected because the coarse pose lay beyond the estimate's reach (fine_reach).
+  std::size_t beyond_estimate_before_fine = 0;
   /// Keyframe submaps whose verification structures were built (again, when the memory budget
   /// had dropped them): the verification cache's misses.
   std::size_t submaps_prepared = 0;

@@ -50,6 +50,8 @@ void describe(Counts& c, Visitor& v) {
   loop_counts_detail::describe_shared(c, v);
   v("prechecked_out", c.prechecked_out,
     "of rejected_by_verification, those its pre-check rejected before the fine stage");
+  v("beyond_estimate_before_fine", c.beyond_estimate_before_fine,
+    "of prechecked_out, those whose coarse pose lay beyond the estimate's reach");
   v("submaps_prepared", c.submaps_prepared,
     "keyframe submaps whose verification structures were built (the cache's misses)");
   v("ruled_out_by_estimate", c.ruled_out_by_estimate,

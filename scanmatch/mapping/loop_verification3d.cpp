@@ -96,7 +96,8 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
 
 LoopVerification3D verify_loop_3d(PreparedCloud& prepared_current,
                                   PreparedCloud& prepared_candidate, const Pose& initial,
-                                  const LoopVerification3DOptions& options) {
+                                  const LoopVerification3DOptions& options,
+                                  const std::optional<LoopExpectation>& expected) {
   const PointCloud &current = prepared_current.cloud(), &candidate = prepared_candidate.cloud();
   LoopVerification3D out;
   out.transform = initial;
@@ -130,6 +131,11 @@ LoopVerification3D verify_loop_3d(PreparedCloud& prepared_current,
     // rejected ones fell below 0.5 and were spared the fine stage.
     const double cell = kPrecheckCells * options.pair_distance;
     out.transform = start;
+    if (expected && (start.translation() - expected->translation).norm() >
+                        expected->radius + options.fine_reach) {
+      out.prechecked_out = out.beyond_expectation = true;
+      return out;
+    }
     if (occupied_share(current, candidate, start, cell) < options.min_overlap ||
         occupied_share(candidate, current, start.inverse(), cell) < options.min_overlap) {
       out.prechecked_out = true;

@@ -5,7 +5,9 @@
 // close to the other's tangent planes and their mean plane distance, and whether the paired
 // surfaces' normals constrain all three translation directions.
 
+#include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <string>
 
 #include "scanmatch/core/point_cloud.hpp"
@@ -32,6 +34,11 @@ struct LoopVerification3DOptions : LoopVerificationOptions {
   /// The coarse stage registers the current submap downsampled to this voxel (m; 0: every point):
   /// a 2 m grid's Gaussians need no more than a point per metre to pull.
   double coarse_source_voxel = 0.5;
+  /// With an expectation (LoopExpectation), a candidate whose coarse pose lies farther than its
+  /// radius plus this (m) from the expected translation is rejected before the fine stage: the
+  /// fine stage moves an accepted loop's pose by centimetres (at most 0.11 m on avia_hku1), while
+  /// it would take metres to end within the radius.
+  double fine_reach = 2.0;
   /// Fine stage: a point-based method from the coarse result.
   std::string fine_method = "gicp";
   double fine_max_correspondence_distance = 1.0;  ///< m
@@ -52,6 +59,8 @@ struct LoopVerification3D {
   /// Rejected by the cheap pre-check before the fine stage (too little of either submap shares
   /// a cell with the other at the coarse pose); the measures below are then unset.
   bool prechecked_out = false;
+  /// Of those, rejected because the coarse pose lay beyond the expectation's reach (fine_reach).
+  bool beyond_expectation = false;
   Pose transform = Pose::Identity();
   double overlap = 0.0;     ///< the smaller agreeing share of the two ways
   double error = 0.0;       ///< m, mean plane distance of the agreeing points (worse way)
@@ -61,6 +70,13 @@ struct LoopVerification3D {
   Matrix6d hessian = Matrix6d::Zero();
 };
 
+/// Where an estimate expects a loop: the current submap's translation in the candidate's frame,
+/// and how far from it (m) an accepted loop may end (LoopClosure3D's max_correction).
+struct LoopExpectation {
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
 /// Verifies that `current` and `candidate` (submaps in their own keyframe frames) show the same
 /// place, starting from `initial` (current in the candidate's frame). Never throws for bad clouds
 /// (too few or non-finite points) or failed registrations: rejects.
@@ -68,8 +84,10 @@ LoopVerification3D verify_loop_3d(const PointCloud& current, const PointCloud& c
                                   const Pose& initial, const LoopVerification3DOptions& options);
 /// The same with the submaps' structures (the coarse method's voxel map, k-d trees, the fine
 /// method's covariances, normals) kept in `current` and `candidate`: built on first use and reused
-/// by later verifications of either submap, with the same result.
+/// by later verifications of either submap, with the same result. With `expected`, the coarse
+/// pose must also lie within its reach (fine_reach).
 LoopVerification3D verify_loop_3d(PreparedCloud& current, PreparedCloud& candidate,
-                                  const Pose& initial, const LoopVerification3DOptions& options);
+                                  const Pose& initial, const LoopVerification3DOptions& options,
+                                  const std::optional<LoopExpectation>& expected = std::nullopt);
 
 }  // namespace scanmatch
