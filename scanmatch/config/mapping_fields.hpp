@@ -108,6 +108,10 @@ template <typename Visitor>
 void describe(LoopVerification3DOptions& o, Visitor& v) {
   v("coarse_method", o.coarse_method, nullptr, "Registration method of the coarse stage");
   v("coarse_resolution", o.coarse_resolution, nullptr, "Coarse stage's voxel grid, m");
+  v("coarse_source_voxel", o.coarse_source_voxel, nullptr,
+    "Coarse stage: the current submap downsampled to this voxel, m (0: every point)");
+  v("fine_reach", o.fine_reach, nullptr,
+    "A coarse pose farther than the estimate's allowance plus this (m) skips the fine stage");
   v("fine_method", o.fine_method, nullptr, "Registration method of the fine stage");
   v("fine_max_correspondence_distance", o.fine_max_correspondence_distance, nullptr,
     "Fine stage's correspondence distance, m");
@@ -150,6 +154,8 @@ void describe(LoopClosure3DOptions& o, Visitor& v) {
   v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
   v("keyframes_between_loops", o.keyframes_between_loops, nullptr,
     "Keyframes without a search after one that added a loop");
+  v("verification_memory_mb", o.verification_memory_mb, nullptr,
+    "MB of submap structures (trees, covariances, voxel maps) kept between verifications");
   v.nested("verification", o.verification);
   v.nested("descriptor", o.descriptor);
   v.nested("graph", o.graph);
