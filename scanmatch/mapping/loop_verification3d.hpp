@@ -3,7 +3,8 @@
 // registration then a fine GICP one (registration/methods.hpp) from the relative pose the
 // candidate implies, then overlap checks both ways: the share of each submap's points that lie
 // close to the other's tangent planes and their mean plane distance, and whether the paired
-// surfaces' normals constrain all three translation directions.
+// surfaces' normals constrain all three translation directions. Submaps verified more than once
+// are passed as PreparedClouds, which keep what the stages build from them.
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -56,8 +57,9 @@ struct LoopVerification3DOptions : LoopVerificationOptions {
 /// frame (the loop edge's measurement T_candidate^-1 T_current).
 struct LoopVerification3D {
   bool accepted = false;
-  /// Rejected by the cheap pre-check before the fine stage (too little of either submap shares
-  /// a cell with the other at the coarse pose); the measures below are then unset.
+  /// Rejected by a cheap pre-check before the fine stage (too little of either submap shares a
+  /// cell with the other at the coarse pose, or the coarse pose lies beyond an expectation's
+  /// reach); the measures below are then unset.
   bool prechecked_out = false;
   /// Of those, rejected because the coarse pose lay beyond the expectation's reach (fine_reach).
   bool beyond_expectation = false;
