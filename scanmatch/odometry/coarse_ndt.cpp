@@ -105,7 +105,13 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   } else if (slow) {
     solved = solve_starts(source, {prior.motion}, true, optima, result.iterations);
   }
+  const Pose plain_motion = result.motion;
   result.motion = best_of(source, result.motion, solved, result.recovered);
+  if (try_starts) {
+    if (result.recovered) result.alternatives.push_back(plain_motion);
+    for (const Pose& s : solved)
+      if (!near(s, result.motion)) result.alternatives.push_back(s);
+  }
   return result;
 }
 

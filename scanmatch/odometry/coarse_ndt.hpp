@@ -39,6 +39,10 @@ struct CoarseResult {
   /// Another start beat the prior's own result: the prior was wrong and the frame recovered.
   bool recovered = false;
   double condition_number = 0.0;  ///< of the plain start's information matrix
+  /// Under an uncertain prior, the other optima the stage found (the plain result first when
+  /// another start won, then the other starts' in the order tried): where to look when `motion`
+  /// lies outside the motion gate.
+  std::vector<Pose> alternatives;
 };
 
 class CoarseNdt {

@@ -21,9 +21,21 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
   const Stopwatch coarse_time;
   const CoarseResult coarse = coarse_.align(frame, prior);
   Pose estimate = last_internal_pose() * coarse.motion;
+  // A winner outside the motion gate would be thrown away and the frame bridged by the bare prior.
+  // An overlay near the identity often wins the score on big steps (a car 14 m on, a hand turned
+  // 30 deg: more of the frame falls inside the last one's view there), while the prior's own
+  // solve, inside the gate, was right: the first optimum inside the gate serves instead.
+  bool recovered = coarse.recovered;
+  if (!within_gate(predicted, estimate))
+    for (std::size_t k = 0; k < coarse.alternatives.size(); ++k)
+      if (within_gate(predicted, last_internal_pose() * coarse.alternatives[k])) {
+        estimate = last_internal_pose() * coarse.alternatives[k];
+        recovered = !(coarse.recovered && k == 0);  // the first is the plain result's
+        break;
+      }
   stats.iterations = coarse.iterations;
   stats.condition_number = coarse.condition_number;
-  stats.recovered = coarse.recovered;
+  stats.recovered = recovered;
   stats.coarse_ms = coarse_time.ms();
 
   // While the map holds frame 0 alone, it is the coarse stage's own reference seen through

@@ -66,6 +66,10 @@ class OdometryPipeline : public FrameOdometry {
   /// another thread while the next frame is read and preprocessed); rethrows its exception.
   /// Called before the next frame's estimate.
   virtual void finish_reference_update() {}
+  /// Whether `estimate` lies within the motion model's gate around `predicted`.
+  bool within_gate(const Pose& predicted, const Pose& estimate) const {
+    return motion_.within_gate(predicted, estimate);
+  }
   /// Forget every reference and start again from `first` (preprocessed, deskewed) as frame 0, at
   /// the internal origin: the first frame, deskewed once the first motion is measured.
   /// Only pipelines constructed with `deskews_again` are asked.
