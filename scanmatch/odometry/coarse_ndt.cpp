@@ -84,8 +84,10 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   const std::vector<Pose> starts = try_starts ? distinct_starts(prior.motion) : std::vector<Pose>{};
   const bool screen = try_starts && should_screen(starts.size(), source.size());
 
-  const NdtFactor factor = hinted_factor(source, grid_, config_);
-  const RegistrationResult plain = optimize(factor, prior.motion, solver_);
+  // One factor on the normal grid for the plain solve, every start's refinement and the scores:
+  // its voxel hints carry over between them.
+  const NdtFactor normal = hinted_factor(source, grid_, config_);
+  const RegistrationResult plain = optimize(normal, prior.motion, solver_);
   result.iterations = plain.iterations;
   result.condition_number = plain.condition_number;
   result.registered = plain.inliers >= kMinimumFramePoints;
@@ -99,14 +101,14 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   if (screen) {
     const std::vector<Pose> ranked =
         screened_starts(source, starts, result.motion, result.screen_iterations);
-    solved = solve_starts(source, ranked, false, optima, result.iterations);
+    solved = solve_starts(normal, ranked, false, optima, result.iterations);
   } else if (try_starts) {
-    solved = solve_starts(source, starts, true, optima, result.iterations);
+    solved = solve_starts(normal, starts, true, optima, result.iterations);
   } else if (slow) {
-    solved = solve_starts(source, {prior.motion}, true, optima, result.iterations);
+    solved = solve_starts(normal, {prior.motion}, true, optima, result.iterations);
   }
   const Pose plain_motion = result.motion;
-  result.motion = best_of(source, result.motion, solved, result.recovered);
+  result.motion = best_of(normal, result.motion, solved, result.recovered);
   if (try_starts) {
     if (result.recovered) result.alternatives.push_back(plain_motion);
     for (const Pose& s : solved)
@@ -139,10 +141,10 @@ std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion) const {
   return starts;
 }
 
-std::vector<Pose> CoarseNdt::solve_starts(const PointCloud& source, const std::vector<Pose>& starts,
+std::vector<Pose> CoarseNdt::solve_starts(const NdtFactor& normal, const std::vector<Pose>& starts,
                                           bool from_wide_grid, KnownOptima& optima,
                                           int& iterations) const {
-  const NdtFactor normal = hinted_factor(source, grid_, config_);
+  const PointCloud& source = normal.source;
   // The descent on the wider grid only has to reach the normal grid's basin: sparser points do.
   const PointCloud sparser = from_wide_grid && config_.start_voxel_size > config_.coarse_voxel_size
                                  ? voxel_downsample(source, config_.start_voxel_size)
@@ -174,10 +176,9 @@ std::vector<Pose> CoarseNdt::solve_starts(const PointCloud& source, const std::v
   return solved;
 }
 
-Pose CoarseNdt::best_of(const PointCloud& source, const Pose& plain,
-                        const std::vector<Pose>& solved, bool& recovered) const {
+Pose CoarseNdt::best_of(const NdtFactor& normal, const Pose& plain, const std::vector<Pose>& solved,
+                        bool& recovered) const {
   if (solved.empty()) return plain;
-  const NdtFactor normal = hinted_factor(source, grid_, config_);
   const auto score = [&](const Pose& motion, std::size_t& inliers) {
     const LinearSystem s = linearize_all(normal, motion, solver_);
     inliers = s.inliers;

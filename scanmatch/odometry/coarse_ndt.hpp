@@ -30,6 +30,7 @@
 namespace scanmatch {
 
 struct KnownOptima;
+struct NdtFactor;
 
 struct CoarseResult {
   Pose motion = Pose::Identity();  ///< from the reference frame (the prior when not registered)
@@ -61,14 +62,14 @@ class CoarseNdt {
   /// The other starts under an uncertain prior, `prior_motion` first, none within `near` of an
   /// earlier one.
   std::vector<Pose> distinct_starts(const Pose& prior_motion) const;
-  /// Solves each start (on the wider grid first when `from_wide_grid`, then on the normal grid)
-  /// and returns the optima not already in `optima`, adding them there; a solve that reaches a
-  /// known optimum stops. Adds the iterations.
-  std::vector<Pose> solve_starts(const PointCloud& source, const std::vector<Pose>& starts,
+  /// Solves each start (on the wider grid first when `from_wide_grid`, then with `normal`, the
+  /// coarse points' factor on the normal grid) and returns the optima not already in `optima`,
+  /// adding them there; a solve that reaches a known optimum stops. Adds the iterations.
+  std::vector<Pose> solve_starts(const NdtFactor& normal, const std::vector<Pose>& starts,
                                  bool from_wide_grid, KnownOptima& optima, int& iterations) const;
-  /// The best of `plain` and `solved` by NDT score on the normal grid; another replaces `plain`
-  /// only when better by kScoreMargin (then `recovered`).
-  Pose best_of(const PointCloud& source, const Pose& plain, const std::vector<Pose>& solved,
+  /// The best of `plain` and `solved` by NDT score (`normal`); another replaces `plain` only when
+  /// better by kScoreMargin (then `recovered`).
+  Pose best_of(const NdtFactor& normal, const Pose& plain, const std::vector<Pose>& solved,
                bool& recovered) const;
   /// Whether `start_count` starts on `source_points` points are ranked on a subset first.
   bool should_screen(std::size_t start_count, std::size_t source_points) const;
