@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "scanmatch/core/error.hpp"
@@ -106,6 +107,13 @@ PointCloud voxel_downsample(const PointCloud& cloud, double voxel_size, VoxelRed
     }
   }
   return select(cloud, std::vector<std::size_t>(best_point.begin(), best_point.end()));
+}
+
+PointCloud thin_to_points(PointCloud cloud, double voxel, std::size_t max_points) {
+  if (max_points == 0 || cloud.size() <= max_points || !(voxel > 0.0)) return cloud;
+  const double scale =
+      std::sqrt(static_cast<double>(cloud.size()) / static_cast<double>(max_points));
+  return voxel_downsample(cloud, voxel * scale);
 }
 
 namespace {

@@ -22,6 +22,11 @@ enum class VoxelReduction {
 PointCloud voxel_downsample(const PointCloud& cloud, double voxel_size,
                             VoxelReduction reduction = VoxelReduction::kCentroid);
 
+/// `cloud`, already filtered with `voxel` (m), when it holds more than `max_points` (0: no limit):
+/// filtered again with a voxel sqrt(size / max_points) times larger, so that about max_points
+/// remain (the points of a scan lie on surfaces, whose voxel count falls with the voxel's square).
+PointCloud thin_to_points(PointCloud cloud, double voxel, std::size_t max_points);
+
 /// Keeps points whose distance from the origin lies in [min_range, max_range].
 PointCloud crop_range(const PointCloud& cloud, double min_range, double max_range);
 

@@ -7,7 +7,6 @@
 
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
-#include "scanmatch/odometry/preprocessor.hpp"
 #include "scanmatch/registration/factors/ndt.hpp"
 
 namespace scanmatch {

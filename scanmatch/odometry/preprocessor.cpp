@@ -117,11 +117,4 @@ PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
   return thin_to_points(std::move(down), voxel, options.max_downsampled_points);
 }
 
-PointCloud thin_to_points(PointCloud cloud, double voxel, std::size_t max_points) {
-  if (max_points == 0 || cloud.size() <= max_points || !(voxel > 0.0)) return cloud;
-  const double scale =
-      std::sqrt(static_cast<double>(cloud.size()) / static_cast<double>(max_points));
-  return voxel_downsample(cloud, voxel * scale);
-}
-
 }  // namespace scanmatch

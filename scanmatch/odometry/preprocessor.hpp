@@ -67,9 +67,4 @@ bool sparse_frame(std::size_t delivered, const PreprocessOptions& options);
 PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
                                const PreprocessOptions& options);
 
-/// `cloud`, filtered with `voxel` (m), when it holds more than `max_points` (0: no limit): filtered
-/// again with a voxel sqrt(size / max_points) times larger, so that about max_points remain (the
-/// points of a scan lie on surfaces, whose voxel count falls with the voxel's square).
-PointCloud thin_to_points(PointCloud cloud, double voxel, std::size_t max_points);
-
 }  // namespace scanmatch
