@@ -451,6 +451,13 @@ TEST(Odometry, NewConfigurationFieldsAreValidatedByName) {
               c.prior_miss_distance = -1.0;
             }).find("prior_miss_distance"),
             std::string::npos);
+  EXPECT_NE(
+      error_for([](OdometryConfig& c) { c.start_voxel_size = -1.0; }).find("start_voxel_size"),
+      std::string::npos);
+  EXPECT_NE(error_for([](OdometryConfig& c) {
+              c.start_voxel_size = std::numeric_limits<double>::quiet_NaN();
+            }).find("start_voxel_size"),
+            std::string::npos);
   EXPECT_EQ(error_for([](OdometryConfig&) {}), "");
 }
 

@@ -28,9 +28,10 @@ void check_odometry_config(const OdometryConfig& c) {
   positive(c.map_radius, "map_radius");
   positive(c.max_range, "max_range");
   positive(c.coarse_tolerance, "coarse_tolerance");
-  if (c.voxel_size < 0.0 || c.coarse_voxel_size < 0.0 || c.start_voxel_size < 0.0 ||
-      c.min_range < 0.0)
+  if (c.voxel_size < 0.0 || c.coarse_voxel_size < 0.0 || c.min_range < 0.0)
     throw Error("odometry: voxel sizes and min_range must not be negative");
+  if (!(c.start_voxel_size >= 0.0))
+    throw Error("odometry: start_voxel_size must be a number, 0 or more (0: not thinned)");
   if (c.merge_threshold == 0) throw Error("odometry: merge_threshold must be at least 1");
   if (c.threads < 1) throw Error("odometry: threads must be at least 1");
   if (!(c.max_step_ratio >= 1.0)) throw Error("odometry: max_step_ratio must be at least 1");
