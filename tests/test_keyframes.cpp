@@ -393,6 +393,38 @@ TEST(AdaptiveRules, ADenseScanIsThinnedToThePointCeiling) {
             plain.points);
 }
 
+TEST(AdaptiveRules, ADenseSequenceIsFilteredOnceAtTheVoxelItsLastFrameNeeded) {
+  // Consecutive 64-beam car scans are alike: the first one above the ceiling finds the voxel that
+  // keeps it under; the next is filtered once at that voxel, from its own points (not thinned
+  // from a finer filter's centroids), and stays under the ceiling too.
+  sim::SimOptions so;
+  so.preset = "urban-hdl64";
+  so.motion_distortion = false;
+  const sim::Simulator simulator(so);
+  const PointCloud first = simulator.frame(10), second = simulator.frame(11);
+  OdometryConfig c;
+  c.max_downsampled_points = static_cast<std::uint32_t>(
+      voxel_downsample(first, c.voxel_size).size() / 2);  // well above the ceiling at voxel_size
+  const PreprocessOptions o = preprocess_options(c, false);
+  DenseVoxelMemory memory;
+  const PointCloud a = adaptive_downsample(first, first.size(), o, &memory);
+  EXPECT_LE(a.size(), c.max_downsampled_points);
+  EXPECT_GT(a.size(), 0.6 * c.max_downsampled_points);
+  EXPECT_GT(memory.voxel, 1.2 * c.voxel_size);
+  const double learned = memory.voxel;
+  const PointCloud b = adaptive_downsample(second, second.size(), o, &memory);
+  EXPECT_EQ(b.points, voxel_downsample(second, learned).points);
+  EXPECT_LE(b.size(), c.max_downsampled_points);
+  EXPECT_DOUBLE_EQ(memory.voxel, learned);  // within the band: the voxel stays
+  // A frame far under the ceiling (the near half of the scan) lets the voxel shrink, never below
+  // voxel_size.
+  const PointCloud near = crop_range(second, 0.0, 12.0);
+  ASSERT_LT(voxel_downsample(near, learned).size(), 0.6 * c.max_downsampled_points);
+  adaptive_downsample(near, second.size(), o, &memory);
+  EXPECT_LT(memory.voxel, learned);
+  EXPECT_GE(memory.voxel, c.voxel_size);
+}
+
 namespace {
 
 // Two recorded Avia keyframes (12 and 13: the sensor turns 12.5 degrees and moves 0.13 m), their

@@ -185,7 +185,7 @@ double accuracy_score(const std::string& sequence, const std::vector<Pose>& pose
   options.voxel_size = 0.25;
   options.min_downsampled_points = 0;
   options.keep_attributes = false;
-  const Preprocessor scoring(options);
+  Preprocessor scoring(options);
   const std::size_t step = std::max<std::size_t>(1, poses.size() / 30);
   double sum = 0.0;
   std::size_t pairs = 0;

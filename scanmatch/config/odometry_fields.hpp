@@ -102,8 +102,8 @@ void describe(OdometryConfig& c, Visitor& v) {
     "sparse frames (below 10x this) keeping fewer points get smaller voxels, to voxel_size / 4 "
     "(0: off)");
   v("max_downsampled_points", c.max_downsampled_points, nullptr,
-    "frames keeping more points after the voxel filter are filtered again with larger voxels, to "
-    "about this many (0: no limit)");
+    "frames keeping more points after the voxel filter are filtered at a larger voxel, learned "
+    "from the last such frame, that keeps under this many (0: no limit)");
   v("dense_sparse_map", c.dense_sparse_map, nullptr,
     "ctf-icp, sparse frames: the map gets the frame at voxel_size / 4, so one keyframe makes "
     "usable map voxels");

@@ -137,11 +137,12 @@ struct OdometryConfig {
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
   std::uint32_t min_downsampled_points = 1000;
-  /// Frames keeping more points after the voxel filter are filtered again with voxels as much
-  /// larger as brings them to about this many (0: no limit). A 64-beam car scan keeps ~40k at
-  /// 0.25 m: every later stage touches each of them, and twice the points made no pose better
-  /// (kitti_raw_0027_first60, sim:urban-hdl64, sim:campus-os1: docs/benchmarks.md, "Dense scans").
-  std::uint32_t max_downsampled_points = 20000;
+  /// Frames keeping more points after the voxel filter are filtered at a larger voxel that keeps
+  /// under this many (0: no limit), learned from the last such frame so that each is filtered once.
+  /// A 64-beam car scan keeps ~40k at 0.25 m and every later stage touches each of them; at 15000
+  /// (~12k kept, 0.6 m voxels) sim:urban-hdl64 and sim:campus-os1 are as accurate as at 20000 and
+  /// kitti_raw_0027_first60 more (docs/benchmarks.md, "Speed on recorded frames").
+  std::uint32_t max_downsampled_points = 15000;
   /// ctf-icp, sparse frames (as above): the map receives the frame filtered at voxel_size / 4,
   /// not the registration's points. A 0.5 m map voxel on a plane gets at most about 4 points of a
   /// 0.25 m-filtered frame, fewer than the 5 the fine stage needs: keyframes that turn into new

@@ -174,9 +174,7 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
 
 PointCloud OdometryPipeline::frame_detail(const PointCloud& frame,
                                           const FrameMotion* motion) const {
-  PointCloud detail;
-  preprocessor_.process(frame, motion, &detail, /*dense_map_points=*/true);
-  return detail;
+  return preprocessor_.map_detail(frame, motion);
 }
 
 Vector6d OdometryPipeline::anchored_part(const Vector6d& motion) const {

@@ -44,6 +44,43 @@ class Deskew {
   Eigen::Matrix4f bins_[kBins];
 };
 
+// A dense frame at `voxel_size`, or under `ceiling` points at a larger voxel, filtered from its
+// own points. A frame above the ceiling is filtered again at a voxel aimed a little under it (up
+// to three times: a spinning sensor's rings thin more slowly than surfaces, so each aim uses how
+// the last two passes scaled); the memory carries the voxel to the next frame, which is then
+// filtered once. A frame far under the ceiling lets the voxel shrink again (never below
+// voxel_size); the band between keeps it from changing every frame.
+PointCloud ceiling_downsample(const PointCloud& cloud, double voxel_size, std::uint32_t ceiling,
+                              DenseVoxelMemory* memory) {
+  constexpr double kAim = 0.85, kShrinkBelow = 0.6;
+  constexpr int kMaxPasses = 3;
+  if (ceiling == 0) return voxel_downsample(cloud, voxel_size);
+  double exponent = 2.0;  // kept points ~ voxel^-exponent: 2 on surfaces, toward 1 along rings
+  const auto aimed = [&](double voxel, std::size_t kept) {
+    const double ratio = static_cast<double>(kept) / (kAim * ceiling);
+    return std::max(voxel_size, voxel * std::pow(ratio, 1.0 / exponent));
+  };
+  double voxel = memory != nullptr ? std::max(voxel_size, memory->voxel) : voxel_size;
+  PointCloud down = voxel_downsample(cloud, voxel);
+  if (down.size() > ceiling) {
+    for (int pass = 0; pass < kMaxPasses && down.size() > ceiling; ++pass) {
+      const double larger = aimed(voxel, down.size());
+      PointCloud coarser = voxel_downsample(cloud, larger);
+      if (coarser.size() < down.size())
+        exponent = std::clamp(
+            std::log(static_cast<double>(down.size()) / coarser.size()) / std::log(larger / voxel),
+            0.5, 3.0);
+      voxel = larger;
+      down = std::move(coarser);
+    }
+    down = thin_to_points(std::move(down), voxel, ceiling);  // the bound, whatever the passes did
+  } else if (down.size() < kShrinkBelow * ceiling) {
+    voxel = aimed(voxel, down.size());
+  }
+  if (memory != nullptr) memory->voxel = voxel;
+  return down;
+}
+
 }  // namespace
 
 PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_attributes) {
@@ -68,9 +105,7 @@ bool sparse_frame(std::size_t delivered, const PreprocessOptions& options) {
   return delivered < kDenseFactor * options.min_downsampled_points;
 }
 
-PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* motion,
-                                 PointCloud* map_points, bool dense_map_points) const {
-  if (map_points != nullptr) map_points->clear();
+PointCloud Preprocessor::crop_and_deskew(const PointCloud& frame, const FrameMotion* motion) const {
   if (!frame.fields_consistent()) return PointCloud{};
   const double min2 = options_.min_range * options_.min_range,
                max2 = options_.max_range * options_.max_range;
@@ -92,22 +127,34 @@ PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* mot
     if (keep_ring) kept.ring.push_back(frame.ring[i]);
     if (keep_intensity) kept.intensity.push_back(frame.intensity[i]);
   }
-  if (map_points != nullptr && (dense_map_points || sparse_frame(frame.size(), options_)))
+  return kept;
+}
+
+PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* motion,
+                                 PointCloud* map_points) {
+  if (map_points != nullptr) map_points->clear();
+  const PointCloud kept = crop_and_deskew(frame, motion);
+  if (map_points != nullptr && sparse_frame(frame.size(), options_))
     *map_points =
         options_.voxel_size > 0.0 ? voxel_downsample(kept, 0.25 * options_.voxel_size) : kept;
-  return adaptive_downsample(kept, frame.size(), options_);
+  return adaptive_downsample(kept, frame.size(), options_, &dense_voxel_);
+}
+
+PointCloud Preprocessor::map_detail(const PointCloud& frame, const FrameMotion* motion) const {
+  PointCloud kept = crop_and_deskew(frame, motion);
+  return options_.voxel_size > 0.0 ? voxel_downsample(kept, 0.25 * options_.voxel_size) : kept;
 }
 
 PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
-                               const PreprocessOptions& options) {
+                               const PreprocessOptions& options, DenseVoxelMemory* memory) {
   if (options.voxel_size <= 0.0) return cloud;
   double voxel = options.voxel_size;
-  PointCloud down = voxel_downsample(cloud, voxel);
   // Only frames delivered sparse (FAST-LIO keyframes): a dense frame that keeps few points sees a
   // near wall or is mostly within min_range, and finer voxels there did not help (dynamic-indoor:
   // 0.1864 -> 0.1878 % ATE when applied to those frames too).
   if (!sparse_frame(delivered, options))
-    return thin_to_points(std::move(down), voxel, options.max_downsampled_points);
+    return ceiling_downsample(cloud, voxel, options.max_downsampled_points, memory);
+  PointCloud down = voxel_downsample(cloud, voxel);
   // Halve the voxel (twice at most) while a sparse frame keeps too few points to register.
   for (int k = 0;
        k < 2 && down.size() < options.min_downsampled_points && down.size() < cloud.size(); ++k) {

@@ -9,7 +9,7 @@
 // - Adaptive voxel filter: voxel_size, and for a sparse frame (delivered with fewer than 10 x
 //   min_downsampled_points points, e.g. FAST-LIO keyframes) that keeps fewer than
 //   min_downsampled_points, smaller voxels (halved at most twice); for a frame that keeps more than
-//   max_downsampled_points, larger ones (one more pass over the kept points).
+//   max_downsampled_points, larger ones, aimed from the last dense frame (DenseVoxelMemory).
 
 #include <cstddef>
 #include <cstdint>
@@ -35,6 +35,13 @@ struct PreprocessOptions {
   bool keep_attributes = true;
 };
 
+/// The voxel that kept the last dense frame under the point ceiling. A sensor's consecutive frames
+/// are alike, so the next one is filtered once at that voxel instead of at voxel_size and again
+/// at a larger one; filtering the points once also keeps centroids of points, not of centroids.
+struct DenseVoxelMemory {
+  double voxel = 0.0;  ///< m; 0: no dense frame seen yet
+};
+
 /// The preprocessing fields of an odometry configuration.
 PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_attributes);
 
@@ -43,15 +50,20 @@ class Preprocessor {
   explicit Preprocessor(const PreprocessOptions& options) : options_(options) {}
   /// The frame cropped, deskewed by `motion` (when given; points without a finite time stay as
   /// they are) and downsampled. Inconsistent fields (a time per point missing) give an empty cloud.
-  /// `map_points`, when given, receives the same frame at map density: for a frame delivered
-  /// sparse (or any frame with `dense_map_points`), filtered at voxel_size / 4; otherwise empty
-  /// (its registration points serve).
+  /// `map_points`, when given, receives the same frame at map density for a frame delivered
+  /// sparse (map_detail), otherwise empty (its registration points serve). Frames above the point
+  /// ceiling teach the next frame its voxel (DenseVoxelMemory).
   PointCloud process(const PointCloud& frame, const FrameMotion* motion = nullptr,
-                     PointCloud* map_points = nullptr, bool dense_map_points = false) const;
+                     PointCloud* map_points = nullptr);
+  /// The frame cropped and deskewed as by process, filtered at voxel_size / 4 (map density).
+  PointCloud map_detail(const PointCloud& frame, const FrameMotion* motion = nullptr) const;
   const PreprocessOptions& options() const { return options_; }
 
  private:
+  PointCloud crop_and_deskew(const PointCloud& frame, const FrameMotion* motion) const;
+
   PreprocessOptions options_;
+  DenseVoxelMemory dense_voxel_;
 };
 
 /// The latest finite point time of `frame`, s (0 without times): how long its sweep took.
@@ -63,8 +75,11 @@ bool sparse_frame(std::size_t delivered, const PreprocessOptions& options);
 /// The adaptive voxel filter alone: voxel_size, then, for a frame delivered with fewer than
 /// 10 x min_downsampled_points points (`delivered`, before the range crop), smaller voxels while
 /// fewer than min_downsampled_points remain (at most down to voxel_size / 4); then, above
-/// max_downsampled_points, thinned toward it (thin_to_points).
+/// max_downsampled_points, filtered at a larger voxel that keeps about that many. With `memory`,
+/// a dense frame starts at the voxel the last one needed (and leaves its own there); without, at
+/// voxel_size.
 PointCloud adaptive_downsample(const PointCloud& cloud, std::size_t delivered,
-                               const PreprocessOptions& options);
+                               const PreprocessOptions& options,
+                               DenseVoxelMemory* memory = nullptr);
 
 }  // namespace scanmatch
