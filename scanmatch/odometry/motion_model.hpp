@@ -28,6 +28,9 @@ struct MotionPrior {
   Pose motion = Pose::Identity();  ///< predicted motion from the last frame's pose
   double scale = 1.0;              ///< time-step ratio applied to the last motion
   bool uncertain = false;          ///< the coarse stage tries other starts; the gate widens
+  /// The time step was more than max_step_ratio times the last one (a clamped scale): over such a
+  /// gap the sensor may have stopped or slowed anywhere, so the gate spans the scaled motion.
+  bool gap = false;
 };
 
 /// `motion` scaled along its own twist: factor 2 is the same motion twice (constant velocity).
@@ -45,8 +48,9 @@ class MotionModel {
   const Pose& velocity() const { return velocity_; }
   /// The last positive time step between frames, s (0.1 until one is known).
   double frame_period() const { return frame_period_; }
-  /// True when `estimate` lies within the gate around `predicted` (widened under an uncertain
-  /// prior) and is finite.
+  /// True when `estimate` is finite and lies within the gate around `predicted` (widened under an
+  /// uncertain prior), or after a time gap within the gate around any fraction of the prior's
+  /// motion (from standing still to going on as before).
   bool within_gate(const Pose& predicted, const Pose& estimate) const;
   /// Motion above `factor` times the deskew dead band (smaller motion is estimation noise).
   bool moving(const Pose& motion, double factor = 1.0) const;
