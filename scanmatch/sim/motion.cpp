@@ -99,6 +99,24 @@ DenseTrajectory drive_along(const GroundPath& path, const Ground* ground, double
   });
 }
 
+double SpeedProfile::distance_at(double t) const {
+  const double ramp = std::max(0.0, (cruise - start) / acceleration);
+  if (t < ramp) return start * t + 0.5 * acceleration * t * t;
+  return start * ramp + 0.5 * acceleration * ramp * ramp + cruise * (t - ramp);
+}
+
+DenseTrajectory cruise_along(const GroundPath& path, const Ground* ground,
+                             const SpeedProfile& speed, double duration, double height,
+                             double vibration) {
+  return DenseTrajectory(duration, [&](double t) {
+    const double s = speed.distance_at(t);
+    const double wobble_roll = vibration * std::sin(2 * M_PI * 3.1 * t);
+    const double wobble_pitch = vibration * std::sin(2 * M_PI * 2.3 * t + 1.0);
+    return pose_on_ground(path.position(s), path.heading(s), ground, height, wobble_roll,
+                          wobble_pitch);
+  });
+}
+
 DenseTrajectory handheld_along(const GroundPath& path, const Ground* ground, double length,
                                double duration, double height) {
   return DenseTrajectory(duration, [&](double t) {

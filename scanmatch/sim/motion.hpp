@@ -58,6 +58,18 @@ class GroundPath {
 /// `height` above the ground, pitched and rolled with the ground's slope, plus a small vibration.
 DenseTrajectory drive_along(const GroundPath& path, const Ground* ground, double length,
                             double duration, double height, double vibration);
+/// A car's speed over time: `start` m/s at the first instant (a recording that begins with the car
+/// already moving), then `acceleration` m/s^2 until it reaches `cruise` m/s, which it holds.
+struct SpeedProfile {
+  double start = 0.0, acceleration = 1.0, cruise = 0.0;
+  /// Distance driven after t seconds.
+  double distance_at(double t) const;
+};
+/// Drives along `path` from its start with the speed `speed` for `duration` seconds, on the ground
+/// like drive_along (pitch and roll from the slope, the same vibration).
+DenseTrajectory cruise_along(const GroundPath& path, const Ground* ground,
+                             const SpeedProfile& speed, double duration, double height,
+                             double vibration);
 /// A hand-held sensor: slow walk along `path` with fast rotations (up to ~250 deg/s in yaw).
 DenseTrajectory handheld_along(const GroundPath& path, const Ground* ground, double length,
                                double duration, double height);

@@ -112,13 +112,14 @@ void Scene::add(const Ellipsoid& e) {
 void Scene::set_ground(const Ground& g) {
   ground_ = g;
   has_ground_ = true;
-  const int n = static_cast<int>(std::ceil(2 * g.half_extent / g.cell));
+  const int nx = static_cast<int>(std::ceil(2 * g.half_extent / g.cell));
+  const int ny = static_cast<int>(std::ceil(2 * g.y_half_extent() / g.cell));
   const auto vertex = [&](int i, int j) {
-    const double x = -g.half_extent + i * g.cell, y = -g.half_extent + j * g.cell;
+    const double x = -g.half_extent + i * g.cell, y = -g.y_half_extent() + j * g.cell;
     return Eigen::Vector3d(x, y, g.height(x, y));
   };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
       add_triangle(vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), g.reflectivity);
       add_triangle(vertex(i, j), vertex(i + 1, j + 1), vertex(i, j + 1), g.reflectivity);
     }
@@ -208,14 +209,14 @@ double Scene::distance_to_surface(const Eigen::Vector3d& p) const {
   for (const Cylinder& c : cylinders_) best = std::min(best, std::abs(signed_distance(c, p)));
   for (const Ellipsoid& e : ellipsoids_) best = std::min(best, std::abs(signed_distance(e, p)));
   if (has_ground_ && std::abs(p.x()) <= ground_.half_extent &&
-      std::abs(p.y()) <= ground_.half_extent) {
+      std::abs(p.y()) <= ground_.y_half_extent()) {
     // Height of the triangulated surface (what the rays hit), not of the analytic one.
     const double gx = (p.x() + ground_.half_extent) / ground_.cell,
-                 gy = (p.y() + ground_.half_extent) / ground_.cell;
+                 gy = (p.y() + ground_.y_half_extent()) / ground_.cell;
     const double i = std::floor(gx), j = std::floor(gy), u = gx - i, v = gy - j;
     const auto h = [&](double a, double b) {
       return ground_.height(-ground_.half_extent + a * ground_.cell,
-                            -ground_.half_extent + b * ground_.cell);
+                            -ground_.y_half_extent() + b * ground_.cell);
     };
     const double z =
         u >= v ? h(i, j) + u * (h(i + 1, j) - h(i, j)) + v * (h(i + 1, j + 1) - h(i + 1, j))

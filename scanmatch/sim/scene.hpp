@@ -23,9 +23,13 @@ struct Ellipsoid {
   float reflectivity = 0.3f;
 };
 /// z = height(x, y) = slope_x x + slope_y y + amplitude sin(x / wavelength) cos(y / wavelength),
-/// over the square [-half_extent, half_extent]^2.
+/// over [-half_extent, half_extent] in x and [-y_half_extent(), y_half_extent()] in y.
 struct Ground {
   double slope_x = 0.0, slope_y = 0.0, amplitude = 0.0, wavelength = 20.0, half_extent = 100.0;
+  /// A long strip instead of a square (a straight road needs no ground far to its sides): the
+  /// half extent in y, 0 for half_extent.
+  double half_extent_y = 0.0;
+  double y_half_extent() const { return half_extent_y > 0.0 ? half_extent_y : half_extent; }
   double cell = 1.0;  ///< triangulation step, m
   float reflectivity = 0.25f;
   double height(double x, double y) const;

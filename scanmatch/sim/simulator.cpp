@@ -31,6 +31,10 @@ std::vector<PresetInfo> make_presets() {
        "car drive with an Ouster OS1-64 (like MulRan KAIST02)", 3000, 1800.0},
       {"urban-hdl64", "campus", "hdl64", "car", "car drive with a Velodyne HDL-64E (KITTI-like)",
        1000, 800.0},
+      {"highway-hdl64", "highway", "hdl64", "highway",
+       "car on a long, nearly straight country road with a Velodyne HDL-64E, 11 m/s "
+       "accelerating to 18 m/s (like KITTI raw 2011_09_26_drive_0027)",
+       600, 1051.0},
       {"handheld-fast", "office", "mid360", "handheld",
        "hand-held sensor with fast rotations in the office", 300, 30.0},
       {"handheld-walk", "office", "avia", "walk",
@@ -49,11 +53,17 @@ World make_world(const std::string& scene, std::uint64_t seed) {
   if (scene == "office") return make_office(seed);
   if (scene == "campus") return make_campus(seed);
   if (scene == "corridors-2d") return make_corridors_2d(seed);
+  if (scene == "highway") return make_highway(seed);
   return make_rooms_2d(seed);
 }
 
+// KITTI raw 2011_09_26_drive_0027's first 60 scans: 11.1 m/s at the first, 16.3 m/s at the
+// 60th (about 0.85 m/s^2, from its GNSS/INS poses and times); the road continues near 18 m/s.
+constexpr SpeedProfile kHighwaySpeed{11.0, 0.9, 18.0};
+
 double sensor_height(const PresetInfo& p) {
   if (p.motion == "car") return 1.8;
+  if (p.motion == "highway") return 1.73;  // KITTI's Velodyne above the road
   if (p.motion == "handheld" || p.motion == "walk") return 1.3;
   if (is_2d_scene(p.scene)) return 0.2;
   return 0.5;
@@ -106,6 +116,14 @@ Simulator::Simulator(const SimOptions& options)
     const double z = height + (ground ? ground->height(s.x(), s.y()) : 0.0);
     const Pose still = from_xyz_rpy(s.x(), s.y(), z, 0, 0, s.z());
     motion_ = DenseTrajectory(duration, [&](double) { return still; });
+  } else if (preset_->motion == "highway") {
+    // One drive down an open road, which ends: no longer runs than the road holds.
+    const GroundPath road(world_.loop, world_.loop_closed);
+    if (kHighwaySpeed.distance_at(duration) > road.length())
+      throw Error("simulator: preset '" + preset_->name + "' drives off the end of its " +
+                  std::to_string(static_cast<int>(road.length())) + " m road within " +
+                  std::to_string(frames_) + " frames (fewer frames, please)");
+    motion_ = cruise_along(road, ground, kHighwaySpeed, duration, height, 0.003);
   } else {
     const GroundPath path(world_.loop, true);
     const double travel_time = static_cast<double>(preset_->frames - 1) * period;

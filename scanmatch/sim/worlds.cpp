@@ -348,4 +348,177 @@ World make_corridors_2d(std::uint64_t seed) {
   return w;
 }
 
+namespace {
+// The highway's layout, in metres. u is the distance along the road's centre line from the
+// start of the drive, d the offset across it (positive to the left of the direction of travel).
+constexpr double kLaneWidth = 3.5;        // two lanes, one each way
+constexpr double kDrivingOffset = -1.75;  // the car keeps to the right lane's centre
+constexpr double kSceneryBehind = 140.0;  // scenery before the start (the sensor sees back)
+constexpr double kSceneryAhead = 140.0;   // and past the end of the drivable road
+// The centre line swings gently (curve radii over 3 km): a long curve and a shorter bend, both
+// straight at the start of the drive, so its first 85 m turn by 0.4 deg (KITTI 0027's: 0.3 deg).
+constexpr double kCurveAmplitude = 6.0;
+constexpr double kCurveWavelength = 1200.0;
+constexpr double kBendAmplitude = 1.0;
+constexpr double kBendWavelength = 600.0;
+
+// The centre line y(u) (x = u + kRoadStartX) and its slope.
+constexpr double kRoadStartX = -550.0;
+double road_y(double u) {
+  return kCurveAmplitude * std::sin(2 * M_PI * u / kCurveWavelength) +
+         kBendAmplitude * std::sin(2 * M_PI * u / kBendWavelength);
+}
+double road_slope(double u) {
+  return kCurveAmplitude * 2 * M_PI / kCurveWavelength * std::cos(2 * M_PI * u / kCurveWavelength) +
+         kBendAmplitude * 2 * M_PI / kBendWavelength * std::cos(2 * M_PI * u / kBendWavelength);
+}
+// The point at offset d from the centre line at u (the offset taken along the normal), and the
+// road's heading there.
+Eigen::Vector2d road_point(double u, double d) {
+  const Eigen::Vector2d tangent = Eigen::Vector2d(1.0, road_slope(u)).normalized();
+  return Eigen::Vector2d(u + kRoadStartX, road_y(u)) +
+         d * Eigen::Vector2d(-tangent.y(), tangent.x());
+}
+double road_heading(double u) {
+  return std::atan(road_slope(u));
+}
+}  // namespace
+
+World make_highway(std::uint64_t seed) {
+  Rng rng(hash_combine(seed, 0x41647A));
+  World w;
+  Scene& s = w.scene;
+  // Rolling farmland: a 0.4 % climb and a gentle swell (grades under 2 %), as KITTI's drive
+  // climbs 0.4 m in its first 85 m. A strip: the sensor sees no ground past ~60 m to the side.
+  Ground ground;
+  ground.slope_x = 0.004;
+  ground.amplitude = 0.8;
+  ground.wavelength = 60;
+  ground.half_extent = 760;  // the scenery spans x from -690 to 740
+  ground.half_extent_y = 150;
+  ground.cell = 2.5;
+  s.set_ground(ground);
+  const auto gz = [&](const Eigen::Vector2d& p) { return ground.height(p.x(), p.y()); };
+  const double u_first = -kSceneryBehind, u_last = kHighwayRoadLength + kSceneryAhead;
+  // A box of `size` (along, across, up) standing on the ground at (u, d), turned with the road.
+  const auto roadside_box = [&](double u, double d, double z_above, Eigen::Vector3d size,
+                                float reflectivity) {
+    const Eigen::Vector2d p = road_point(u, d);
+    box_at(s, p.x(), p.y(), gz(p) + z_above, size, road_heading(u), reflectivity);
+  };
+  // A run of boxes along the road from u0 to u1 at offset d, `piece` m each (they follow the
+  // curve): kerbs, rails, walls.
+  const auto along = [&](double u0, double u1, double d, double piece, double z_above,
+                         double across, double height, float reflectivity) {
+    for (double u = u0; u + piece <= u1; u += piece)
+      roadside_box(u + 0.5 * piece, d, z_above, {piece - 0.02, across, height}, reflectivity);
+  };
+
+  // Kerbs: a low stone edge on both sides, the whole length (they fix height and the lateral
+  // position, not the position along the road).
+  for (double side : {-1.0, 1.0})
+    along(u_first, u_last, side * (kLaneWidth + 0.15), 5.0, -0.1, 0.25, 0.22, 0.35f);
+
+  // Guard rail on the left (oncoming) side along stretches of 100-300 m: a steel beam at
+  // 0.55-0.85 m on posts every 2 m. The posts repeat at 2 m, near a car's step per frame.
+  for (double u = u_first + rng.uniform(0, 80); u < u_last;) {
+    const double length = rng.uniform(100, 300);
+    const double end = std::min(u + length, u_last);
+    const double d = kLaneWidth + 1.0;
+    along(u, end, d, 4.0, 0.55, 0.08, 0.3, 0.7f);
+    for (double post = u; post <= end; post += 2.0)
+      roadside_box(post, d + 0.12, -0.2, {0.12, 0.12, 1.0}, 0.5f);
+    u = end + rng.uniform(80, 250);
+  }
+
+  // Hedgerows along both sides, 8-13 m out, in runs of 30-150 m with gaps: trimmed segments
+  // of uneven height and depth, the dense low walls that line KITTI 0027's road (a quarter of
+  // its points are over 0.7 m above the road, most of them 6-16 m to the side). Their long faces
+  // run along the road; only their ends and steps fix a position along it.
+  for (double side : {-1.0, 1.0})
+    for (double u = u_first + rng.uniform(0, 20); u < u_last;) {
+      const double end = std::min(u + rng.uniform(30, 150), u_last);
+      const double offset = rng.uniform(8, 12);
+      for (double piece = rng.uniform(3, 7); u + piece <= end;
+           u += piece, piece = rng.uniform(3, 7))
+        roadside_box(u + 0.5 * piece, side * (offset + rng.uniform(-0.6, 0.6)), -0.1,
+                     {piece, rng.uniform(1.5, 2.5), rng.uniform(1.2, 3.2)}, 0.3f);
+      u = end + rng.uniform(5, 40);
+    }
+
+  // Trees on the verges at irregular spacing (clumps and gaps), trunk and crown: what mostly
+  // fixes a scan along the road, as on KITTI's rural roads.
+  for (double side : {-1.0, 1.0})
+    for (double u = u_first + rng.uniform(0, 10); u < u_last;) {
+      const Eigen::Vector2d p = road_point(u, side * rng.uniform(6.5, 14.0));
+      const double z = gz(p), trunk = rng.uniform(2.0, 4.0);
+      s.add(Cylinder{p, rng.uniform(0.12, 0.3), z - 0.2, z + trunk, 0.35f});
+      s.add(Ellipsoid{Eigen::Vector3d(p.x(), p.y(), z + trunk + 1.4),
+                      Eigen::Vector3d(2.2, 2.2, 1.8) * rng.uniform(0.7, 1.4), 0.25f});
+      u += rng.uniform() < 0.15 ? rng.uniform(40, 90) : rng.uniform(5, 18);
+    }
+
+  // Utility poles on the right verge, 35-50 m apart, and a traffic sign now and then.
+  for (double u = u_first + rng.uniform(0, 30); u < u_last; u += rng.uniform(35, 50)) {
+    const Eigen::Vector2d p = road_point(u, -(kLaneWidth + 2.0));
+    s.add(Cylinder{p, 0.13, gz(p) - 0.2, gz(p) + 8.5, 0.5f});
+  }
+  for (double u = u_first + rng.uniform(20, 120); u < u_last; u += rng.uniform(100, 250)) {
+    const double d = -(kLaneWidth + 1.2);
+    roadside_box(u, d, -0.2, {0.08, 0.08, 2.4}, 0.5f);  // post
+    roadside_box(u, d, 1.6, {0.05, 0.8, 0.8}, 0.9f);    // plate, facing the traffic
+  }
+
+  // Field fences on either side along stretches: 2.5 m panels, 1.3 m high.
+  for (double side : {-1.0, 1.0})
+    for (double u = u_first + rng.uniform(0, 150); u < u_last;) {
+      const double end = std::min(u + rng.uniform(60, 200), u_last);
+      along(u, end, side * rng.uniform(16, 20), 2.5, -0.1, 0.05, 1.4, 0.45f);
+      u = end + rng.uniform(100, 300);
+    }
+
+  // Farm houses and sheds set back from the road every 60-250 m on either side, each with a
+  // car or two parked on its driveway beside the road.
+  for (double u = u_first + rng.uniform(20, 80); u < u_last; u += rng.uniform(60, 250)) {
+    const double side = rng.uniform() < 0.5 ? -1.0 : 1.0;
+    const double d = side * rng.uniform(25, 45);
+    const Eigen::Vector2d p = road_point(u, d);
+    const double height = rng.uniform(5, 11);
+    box_at(s, p.x(), p.y(), gz(p) - 1.0, {rng.uniform(10, 22), rng.uniform(8, 14), height + 1.0},
+           road_heading(u) + rng.uniform(-0.3, 0.3), 0.55f);
+    const int cars = 1 + static_cast<int>(rng.uniform() < 0.5);
+    for (int k = 0; k < cars; ++k) {
+      const double cu = u + rng.uniform(-8, 8), cd = side * (kLaneWidth + rng.uniform(3.0, 5.0));
+      roadside_box(cu, cd, 0.25, {4.4, 1.8, 0.8}, 0.8f);  // body
+      roadside_box(cu, cd, 1.05, {2.4, 1.6, 0.6}, 0.8f);  // cabin
+    }
+  }
+
+  // A sign gantry over the road: two posts on the verges and a beam 6 m up carrying two boards.
+  {
+    const double u = rng.uniform(300, 400);
+    for (double side : {-1.0, 1.0})
+      roadside_box(u, side * (kLaneWidth + 2.5), -0.3, {0.4, 0.4, 7.3}, 0.6f);
+    roadside_box(u, 0.0, 6.0, {0.5, 2 * kLaneWidth + 5.4, 0.6}, 0.6f);
+    for (double d : {-kLaneWidth / 2, kLaneWidth / 2})
+      roadside_box(u + 0.3, d, 5.2, {0.1, 3.0, 2.2}, 0.9f);
+  }
+  // An overpass: a 12 m wide deck 6.5 m up on two abutment walls beside the road.
+  {
+    const double u = rng.uniform(700, 800);
+    for (double side : {-1.0, 1.0})
+      roadside_box(u, side * (kLaneWidth + 4.0), -0.5, {12.0, 1.0, 7.5}, 0.5f);
+    roadside_box(u, 0.0, 6.5, {12.0, 40.0, 1.2}, 0.5f);
+  }
+
+  for (double u = 0.0; u <= kHighwayRoadLength; u += 2.0)
+    w.loop.push_back(road_point(u, kDrivingOffset));
+  w.loop_closed = false;
+  w.replay_start = road_point(0.0, kDrivingOffset);
+  const Eigen::Vector2d still = road_point(20.0, -(kLaneWidth + 1.5));
+  w.still_position = Eigen::Vector3d(still.x(), still.y(), road_heading(20.0));
+  s.commit();
+  return w;
+}
+
 }  // namespace scanmatch::sim
