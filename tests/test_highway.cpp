@@ -110,7 +110,7 @@ TEST(HighwayHdl64, EverySweepIsSmearedByTheCarsMotion) {
   // Each point lies on the scene where the pose at its own time puts it (the crowns are faceted:
   // a median). Under the sweep's start pose the late points of objects (off the road surface,
   // along which a shift hides) land off their surfaces by up to the car's motion in the sweep,
-  // except on faces along the road: 16 % of them by more than 0.1 m (seed 1).
+  // except on faces along the road: 64 % of them by more than 0.1 m (seed 1).
   const Pose start = sim.scene_pose_at(sim.frame_time(30));
   std::vector<double> own_time;
   std::size_t late_objects = 0, late_objects_off = 0;
@@ -125,7 +125,7 @@ TEST(HighwayHdl64, EverySweepIsSmearedByTheCarsMotion) {
   }
   EXPECT_LT(median(own_time), 1e-3);
   ASSERT_GT(late_objects, 500u);
-  EXPECT_GT(static_cast<double>(late_objects_off) / static_cast<double>(late_objects), 0.08)
+  EXPECT_GT(static_cast<double>(late_objects_off) / static_cast<double>(late_objects), 0.3)
       << late_objects_off << " of " << late_objects;
 }
 
@@ -164,7 +164,7 @@ RunSummary ctf_icp_on_highway(std::size_t frames, bool timed, const OdometryConf
 // regression guard with exact truth (not a figure to reach); without them (KITTI's raw scans have
 // none) the smeared sweeps cost several times the error, and times derived from the azimuth
 // (--spin-times; the simulator's sweep starts ahead and turns counter-clockwise) win it back.
-// Measured 2026-11-27 on 35 frames (42.6 m): ATE 0.019 m timed, 0.111 m untimed.
+// Measured 2026-11-27 on 35 frames (42.6 m): ATE 0.022 m timed, 0.124 m untimed.
 TEST(HighwayHdl64, CtfIcpNeedsTheSweepsTimesOnTheFirstFrames) {
   const std::size_t frames = sanitized() ? 12 : 35;
   OdometryConfig plain, retimed;
