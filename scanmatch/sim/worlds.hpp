@@ -11,7 +11,7 @@ namespace scanmatch::sim {
 
 struct World {
   Scene scene;
-  std::vector<Eigen::Vector2d> loop;  ///< path through free space, closed unless `loop_closed`
+  std::vector<Eigen::Vector2d> loop;  ///< path through free space (see loop_closed)
   bool loop_closed = true;            ///< false: an open road driven once from its first point
   Eigen::Vector3d still_position;     ///< where still presets stand (x, y, yaw)
   /// Where a replayed trajectory starts (heading +x); the loop's start when not set.
@@ -33,10 +33,11 @@ World make_rooms_2d(std::uint64_t seed);
 World make_corridors_2d(std::uint64_t seed);
 inline constexpr double kCorridorHalfWidth = 1.2;
 /// A long, nearly straight two-lane country road (like KITTI raw 2011_09_26_drive_0027): gentle
-/// curves (radius over 1 km), kerbs, a guard rail and fences along stretches, trees and poles at
-/// irregular spacing, a few buildings set back with cars parked before them, a sign gantry and an
-/// overpass. Little but the trees, poles and buildings fixes a position along the road. The path
-/// (open) is the right lane's centre line, kHighwayRoadLength long, starting heading about +x.
+/// curves (radii over 3 km), kerbs, a guard rail and fences along stretches, hedgerows of bushes,
+/// trees and poles at irregular spacing, a few buildings set back with cars parked before them, a
+/// sign gantry and an overpass. Only the bushes, trees, poles and buildings fix a position along
+/// the road. The path (open) is the right lane's centre line, kHighwayRoadLength long, starting
+/// heading about +x.
 World make_highway(std::uint64_t seed);
 inline constexpr double kHighwayRoadLength = 1150.0;
 
