@@ -161,11 +161,16 @@ World make_office(std::uint64_t seed) {
     wall(s, {outer, -8}, {outer, 8}, 0, h);
     wall_with_doors(s, {inner, -8}, {inner, 8}, {{8.0, 2.5}}, 0, h);
     furnish_hall(s, rng, xa, xb, -8, 8, h);
-    // A few boxes and a side room door frame give the halls structure in every direction.
-    box_at(s, 0.5 * (xa + xb) + rng.uniform(-2, 2), -5.5, 0, {1.2, 1.2, 1.0}, rng.uniform(0, 1),
-           0.6f);
-    box_at(s, 0.5 * (xa + xb) + rng.uniform(-2, 2), 5.5, 0, {0.6, 2.0, 1.8}, rng.uniform(0, 1),
-           0.6f);
+    // A few boxes and a side room door frame give the halls structure in every direction. One
+    // draw per statement, in the order the scenes were first built with (arguments' evaluation
+    // order is unspecified: draws inside one call would differ between compilers).
+    for (const double y : {-5.5, 5.5}) {
+      const double yaw = rng.uniform(0, 1);
+      const double x = 0.5 * (xa + xb) + rng.uniform(-2, 2);
+      const Eigen::Vector3d size =
+          y < 0 ? Eigen::Vector3d(1.2, 1.2, 1.0) : Eigen::Vector3d(0.6, 2.0, 1.8);
+      box_at(s, x, y, 0, size, yaw, 0.6f);
+    }
   }
   // The corridor: plain walls, 36 m long.
   wall(s, {0, -1.25}, {36, -1.25}, 0, h, 0.65f);
@@ -245,17 +250,21 @@ World make_campus(std::uint64_t seed) {
     }
   };
   for (double x = -rx + 10; x < rx - 10; x += rng.uniform(22, 30)) {
-    building(x, -ry - 16 - rng.uniform(0, 4), rng.uniform(12, 18), rng.uniform(8, 12),
-             rng.uniform(-0.05, 0.05));
-    building(x + 5, ry + 16 + rng.uniform(0, 4), rng.uniform(12, 18), rng.uniform(8, 12),
-             rng.uniform(-0.05, 0.05));
-    building(x + 3, -ry + 18 + rng.uniform(0, 3), rng.uniform(10, 14), rng.uniform(8, 10), 0.0);
-    building(x - 2, ry - 18 - rng.uniform(0, 3), rng.uniform(10, 14), rng.uniform(8, 10), 0.0);
+    for (const double side : {-1.0, 1.0}) {  // outside the loop: below, then above
+      const double yaw = rng.uniform(-0.05, 0.05), sy = rng.uniform(8, 12);
+      const double sx = rng.uniform(12, 18), back = rng.uniform(0, 4);
+      building(side < 0 ? x : x + 5, side * (ry + 16 + back), sx, sy, yaw);
+    }
+    for (const double side : {-1.0, 1.0}) {  // inside the loop
+      const double sy = rng.uniform(8, 10), sx = rng.uniform(10, 14), back = rng.uniform(0, 3);
+      building(side < 0 ? x + 3 : x - 2, side * (ry - 18 - back), sx, sy, 0.0);
+    }
   }
-  for (double y = -ry + 12; y < ry - 12; y += rng.uniform(20, 28)) {
-    building(-rx - 16 - rng.uniform(0, 4), y, rng.uniform(8, 12), rng.uniform(12, 18), 0.0);
-    building(rx + 16 + rng.uniform(0, 4), y, rng.uniform(8, 12), rng.uniform(12, 18), 0.0);
-  }
+  for (double y = -ry + 12; y < ry - 12; y += rng.uniform(20, 28))
+    for (const double side : {-1.0, 1.0}) {  // left and right of the loop
+      const double sy = rng.uniform(12, 18), sx = rng.uniform(8, 12), back = rng.uniform(0, 4);
+      building(side * (rx + 16 + back), y, sx, sy, 0.0);
+    }
   // Trees, poles and parked cars along the roads; a fence along part of each side.
   const auto roadside = [&](Eigen::Vector2d a, Eigen::Vector2d b, Eigen::Vector2d outward) {
     const double length = (b - a).norm();
@@ -311,9 +320,11 @@ World make_rooms_2d(std::uint64_t seed) {
   wall_with_doors(s, {0, 4}, {15, 4}, {{2.5, 1.2}, {7.5, 1.2}, {12.5, 1.2}}, 0, h);
   for (int room = 0; room < 3; ++room) {
     const double x0 = 5.0 * room;
-    box_at(s, x0 + rng.uniform(0.8, 1.5), rng.uniform(0.6, 1.0), 0, {1.0, 0.6, 0.8}, 0.0, 0.5f);
-    box_at(s, x0 + rng.uniform(3.2, 4.2), rng.uniform(2.0, 3.0), 0, {0.5, 0.5, 0.5},
-           rng.uniform(0, 1.5), 0.5f);
+    const double table_y = rng.uniform(0.6, 1.0), table_x = x0 + rng.uniform(0.8, 1.5);
+    box_at(s, table_x, table_y, 0, {1.0, 0.6, 0.8}, 0.0, 0.5f);
+    const double box_yaw = rng.uniform(0, 1.5), box_y = rng.uniform(2.0, 3.0),
+                 box_x = x0 + rng.uniform(3.2, 4.2);
+    box_at(s, box_x, box_y, 0, {0.5, 0.5, 0.5}, box_yaw, 0.5f);
   }
   w.loop = {{1.5, 5.0}, {2.5, 2.5},  {2.5, 5.0},  {7.5, 5.0}, {7.5, 2.2},
             {7.5, 5.0}, {12.5, 5.0}, {12.5, 2.0}, {13.5, 5.2}};
