@@ -38,7 +38,9 @@ std::vector<PlanarScanPair> planar_scan_pairs(const PlanarPairOptions& options) 
     const int room = static_cast<int>(rng.uniform(0, 3)) % 3;
     Eigen::Vector2d a;
     do {
-      a = Eigen::Vector2d(5.0 * room + rng.uniform(0.7, 4.3), rng.uniform(0.7, 3.3));
+      // One draw per statement (the order of a call's arguments is unspecified), as first built.
+      const double y = rng.uniform(0.7, 3.3);
+      a = Eigen::Vector2d(5.0 * room + rng.uniform(0.7, 4.3), y);
     } while (world.scene.distance_to_surface(Eigen::Vector3d(a.x(), a.y(), 0.2)) < 0.4);
     const double yaw = rng.uniform(-M_PI, M_PI);
     const double r = options.max_translation * std::sqrt(rng.uniform(0, 1));
