@@ -1,5 +1,7 @@
 #include "scanmatch/registration/solver.hpp"
 
+#include "scanmatch/core/parallel.hpp"
+
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -42,8 +44,7 @@ LinearSystem reduce_parallel(
     std::size_t n, int num_threads,
     const std::function<void(std::size_t, std::size_t, LinearSystem&)>& block) {
   tbb::enumerable_thread_specific<LinearSystem> partial;
-  tbb::task_arena arena(num_threads);
-  arena.execute([&] {
+  shared_arena(num_threads).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         block(r.begin(), r.end(), partial.local());
