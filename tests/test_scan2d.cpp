@@ -377,6 +377,64 @@ TEST(Scan2D, CorrelativeGridServesEverySearchOntoItsReference) {
                Error);
 }
 
+TEST(Scan2D, CorrelativeSearchesFindWhatEachSearchFindsAlone) {
+  // The odometry's searches about one guess (narrow, wide, whole turn, long), each from the best
+  // score so far: the later ones skip the earlier windows but return what a search of their whole
+  // window returns, to the bit. Guesses on the truth, 60 and 120 degrees off it (the wide and the
+  // whole-turn search find it beyond the earlier windows) and 2.5 m behind it (the long search).
+  const double degree = M_PI / 180;
+  struct Search {
+    Vec2 window;
+    double angle;
+  };
+  const std::vector<Search> searches = {{Vec2(1.3, 1.3), 45 * degree},
+                                        {Vec2(1.3, 1.3), 90 * degree},
+                                        {Vec2(1.3, 1.3), 180 * degree},
+                                        {Vec2(3.5, 1.3), 90 * degree}};
+  int compared = 0, found_beyond = 0;
+  for (const sim::PlanarScanPair& laser : pairs(scanmatch::testing::sanitized() ? 3 : 8)) {
+    const Scan2D reference = scan_from_laser(laser.reference),
+                 current = scan_from_laser(laser.current);
+    const CorrelativeGrid grid(reference, 0.05, 1.0);
+    const Pose2& truth = laser.truth;
+    const Vec2 t = truth.translation();
+    const double yaw = pose2_angle(truth);
+    for (const Pose2& guess :
+         {truth, pose2(t.x(), t.y(), yaw + 60 * degree), pose2(t.x(), t.y(), yaw - 120 * degree),
+          pose2(t.x() - 2.5, t.y(), yaw)}) {
+      CorrelativeSearches together(current, grid, guess);
+      double score = 0.0;
+      for (std::size_t i = 0; i < searches.size(); ++i) {
+        const Search& s = searches[i];
+        const CorrelativeMatch a = together.match(s.window, s.angle, score);
+        const CorrelativeMatch b =
+            correlative_match(current, grid, guess, s.window, s.angle, score);
+        ++compared;
+        ASSERT_EQ(a.found, b.found) << "search " << i;
+        EXPECT_EQ(a.score, b.score) << "search " << i;
+        EXPECT_TRUE(a.pose.isApprox(b.pose, 1e-12)) << "search " << i;
+        if (!a.found) continue;
+        // Beyond the earlier windows inside this one: the skipped part did not hide the answer.
+        const Vec2 moved = a.pose.translation() - guess.translation();
+        const double turned = std::abs(pose2_angle(guess.inverse() * a.pose));
+        found_beyond += (i == 1 || i == 2) ? turned > searches[i - 1].angle + 1e-9
+                                           : i == 3 && std::abs(moved.x()) > 1.3 + 1e-9;
+        score = a.score;
+      }
+      // A search that found nothing above a high minimum says nothing about lower scores.
+      CorrelativeSearches strict(current, grid, guess);
+      const Search& narrow = searches[0];
+      EXPECT_FALSE(strict.match(narrow.window, narrow.angle, 0.999).found);
+      const CorrelativeMatch a = strict.match(narrow.window, 2 * narrow.angle);
+      const CorrelativeMatch b =
+          correlative_match(current, grid, guess, narrow.window, 2 * narrow.angle);
+      EXPECT_EQ(a.score, b.score);
+      EXPECT_TRUE(a.pose.isApprox(b.pose, 1e-12));
+    }
+  }
+  EXPECT_GT(found_beyond, compared / 8);
+}
+
 TEST(Scan2D, CorrelativeSpreadIsLongAlongACorridorAndShowsABetterPoseElsewhere) {
   const auto largest = [](const CorrelativeSpread& s) {
     return std::sqrt(

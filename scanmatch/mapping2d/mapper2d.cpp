@@ -158,7 +158,9 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
       // Each search's score (correlative_match's share) beside its refined pose.
       double score = 0.0;
       const Eigen::Vector2d window = Eigen::Vector2d::Constant(o.search_window);
-      CorrelativeMatch match = correlative_match(current, grid, guess, window, o.search_angle);
+      // Each wider search looks again at no earlier window (same poses, far fewer scores).
+      CorrelativeSearches searches(current, grid, guess);
+      CorrelativeMatch match = searches.match(window, o.search_angle);
       score = match.score;
       r = refine_searched(current, prepared, o, match.pose);
       // A turn beyond the search's angle window leaves most points off the reference.
@@ -171,8 +173,7 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
         // Every wider window here holds the first search's, so its best scores at least as
         // high: poses below the best score so far need no look (the bounds prune from the
         // start), and where none reaches it the best so far stands.
-        match = correlative_match(current, grid, guess, wider_window, angle,
-                                  std::clamp(score, 0.0, 1.0));
+        match = searches.match(wider_window, angle, std::clamp(score, 0.0, 1.0));
         if (!match.found) return false;
         const Registration2DResult w = refine_searched(current, prepared, o, match.pose);
         const double fitted = fit(current, w.transform);

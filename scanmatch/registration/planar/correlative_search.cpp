@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -20,24 +21,43 @@ using Vec2 = Eigen::Vector2d;
 /// level below it, so level k's blocks have side kSides[k] = kBranch^k.
 constexpr int kBranch = 4;
 constexpr int kLevels = 4;
-constexpr std::array<int, kLevels> kSides = {1, kBranch, kBranch* kBranch,
-                                             kBranch* kBranch* kBranch};
+constexpr std::array<int, kLevels> kSides = [] {
+  std::array<int, kLevels> sides{};
+  for (int k = 0, side = 1; k < kLevels; ++k, side *= kBranch)
+    sides[static_cast<std::size_t>(k)] = side;
+  return sides;
+}();
 constexpr int kTopSide = kSides[kLevels - 1];
-constexpr std::int64_t kMaxCells = 16'000'000;
+static_assert(kTopSide == 64);
+/// Cells of one level beyond which the grid coarsens.
+constexpr std::int64_t kMaxCellsPerLevel = 4'000'000;
+
+/// The smoothing kernel: a Gaussian of sigma = one cell around each reference point, out to
+/// kRadius cells. Its values are few (one per squared distance), so a cell holds a code: 0 off
+/// every surface, then the kernel's values in increasing order, so that the maximum of codes is the
+/// code of the maximum. A quarter of the floats' memory (the searches' reads miss the cache less)
+/// and the same sums to the bit.
+constexpr int kRadius = 2;
+using Code = std::uint8_t;
+constexpr int kCodes = 7;  // zero and one per squared distance 0, 1, 2, 4, 5, 8
 
 struct LikelihoodGrid {
   double resolution = 0.05;
   Vec2 origin = Vec2::Zero();  ///< world position of cell (0, 0)'s corner
   int width = 0, height = 0;
-  /// levels[0] is the smoothed likelihood; levels[k](x, y) = max of levels[0] over the square of
-  /// side kBranch^k from (x, y) towards +x and +y.
-  std::vector<std::vector<float>> levels;
+  std::array<float, kCodes> likelihood{};  ///< by code
+  /// Level k's codes start at k * cells(): level 0 is the smoothed likelihood; level k's (x, y) is
+  /// the maximum of level 0 over the square of side kBranch^k from (x, y) towards +x and +y.
+  std::vector<Code> codes;
 
-  float at(int level, int x, int y) const {
+  std::size_t cells() const {
+    return static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  }
+  const Code* level(int k) const { return codes.data() + static_cast<std::size_t>(k) * cells(); }
+  float at(int k, int x, int y) const {
     if (x < 0 || y < 0 || x >= width || y >= height) return 0.0f;
-    return levels[static_cast<std::size_t>(level)]
-                 [static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                  static_cast<std::size_t>(x)];
+    return likelihood[level(k)[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                               static_cast<std::size_t>(x)]];
   }
 };
 
@@ -54,9 +74,9 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
   }
   const auto cells = [&](double r) {
     const Vec2 size = high - low;
-    return (size.x() / r + kTopSide + 6) * (size.y() / r + kTopSide + 6) * kLevels;
+    return (size.x() / r + kTopSide + 6) * (size.y() / r + kTopSide + 6);
   };
-  while (cells(resolution) > static_cast<double>(kMaxCells)) resolution *= 2;
+  while (cells(resolution) > static_cast<double>(kMaxCellsPerLevel)) resolution *= 2;
   low -= Vec2::Constant((kTopSide + 3) * resolution);
   high += Vec2::Constant(3 * resolution);
   const Vec2 size = high - low;
@@ -64,57 +84,57 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
   g.origin = low;
   g.width = static_cast<int>(std::ceil(size.x() / resolution)) + 1;
   g.height = static_cast<int>(std::ceil(size.y() / resolution)) + 1;
-  const std::size_t n = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
-  g.levels.assign(kLevels, {});
-  std::vector<float>& fine = g.levels[0];
-  fine.assign(n, 0.0f);
-  const auto index = [&](int x, int y) {
-    return static_cast<std::size_t>(y) * static_cast<std::size_t>(g.width) +
-           static_cast<std::size_t>(x);
-  };
-  // Gaussian of sigma = one cell around each reference point, out to two cells.
-  const int radius = 2;
-  float kernel[2 * radius + 1][2 * radius + 1];
-  for (int dy = -radius; dy <= radius; ++dy)
-    for (int dx = -radius; dx <= radius; ++dx)
-      kernel[dy + radius][dx + radius] = static_cast<float>(std::exp(-0.5 * (dx * dx + dy * dy)));
+  const std::size_t n = g.cells();
+  const std::size_t width = static_cast<std::size_t>(g.width);
+  g.codes.assign(n * kLevels, 0);
+  Code* fine = g.codes.data();
+  // Kernel values by squared distance, in increasing order, and each offset's code.
+  constexpr std::array<int, kCodes - 1> kSquaredDistances = {8, 5, 4, 2, 1, 0};
+  Code kernel[2 * kRadius + 1][2 * kRadius + 1];
+  for (std::size_t c = 1; c < kCodes; ++c)
+    g.likelihood[c] = static_cast<float>(std::exp(-0.5 * kSquaredDistances[c - 1]));
+  for (int dy = -kRadius; dy <= kRadius; ++dy)
+    for (int dx = -kRadius; dx <= kRadius; ++dx) {
+      const auto code =
+          std::find(kSquaredDistances.begin(), kSquaredDistances.end(), dx * dx + dy * dy) -
+          kSquaredDistances.begin() + 1;
+      kernel[dy + kRadius][dx + kRadius] = static_cast<Code>(code);
+    }
   for (const Vec2& p : reference) {
     const int cx = static_cast<int>(std::floor((p.x() - low.x()) / resolution));
     const int cy = static_cast<int>(std::floor((p.y() - low.y()) / resolution));
-    for (int dy = -radius; dy <= radius; ++dy)
-      for (int dx = -radius; dx <= radius; ++dx) {
+    for (int dy = -kRadius; dy <= kRadius; ++dy)
+      for (int dx = -kRadius; dx <= kRadius; ++dx) {
         const int x = cx + dx, y = cy + dy;
         if (x < 0 || y < 0 || x >= g.width || y >= g.height) continue;
-        float& cell = fine[index(x, y)];
-        cell = std::max(cell, kernel[dy + radius][dx + radius]);
+        Code& cell = fine[static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)];
+        cell = std::max(cell, kernel[dy + kRadius][dx + kRadius]);
       }
   }
-  // Each level from the one below: the maximum of kBranch cells `stride` apart along +x, then
-  // +y. Off the grid counts as zero; written branch-free over whole rows so that it vectorizes.
-  const std::size_t width = static_cast<std::size_t>(g.width);
-  std::vector<float> rows(n);
+  // Each level from the one below: the maximum of kBranch cells `stride` apart along +x, then, in
+  // place, along +y (row y reads only rows after it, not yet overwritten). Off the grid counts as
+  // zero; written branch-free over whole rows so that it vectorizes.
+  const std::size_t height = static_cast<std::size_t>(g.height);
   std::size_t stride = 1;
   for (std::size_t level = 1; level < kLevels; ++level, stride *= kBranch) {
-    const std::vector<float>& below = g.levels[level - 1];
-    for (std::size_t y = 0; y < static_cast<std::size_t>(g.height); ++y) {
-      const float* in = below.data() + y * width;
-      float* out = rows.data() + y * width;
-      std::copy(in, in + width, out);
+    const Code* below = g.codes.data() + (level - 1) * n;
+    Code* out = g.codes.data() + level * n;
+    for (std::size_t y = 0; y < height; ++y) {
+      const Code* in = below + y * width;
+      Code* row = out + y * width;
+      std::copy(in, in + width, row);
       for (std::size_t k = 1; k < kBranch && k * stride < width; ++k) {
-        const float* shifted = in + k * stride;
+        const Code* shifted = in + k * stride;
         const std::size_t count = width - k * stride;
-        for (std::size_t x = 0; x < count; ++x) out[x] = std::max(out[x], shifted[x]);
+        for (std::size_t x = 0; x < count; ++x) row[x] = std::max(row[x], shifted[x]);
       }
     }
-    std::vector<float>& out = g.levels[level];
-    out.resize(n);
-    for (std::size_t y = 0; y < static_cast<std::size_t>(g.height); ++y) {
-      float* row = out.data() + y * width;
-      std::copy(rows.data() + y * width, rows.data() + (y + 1) * width, row);
+    for (std::size_t y = 0; y < height; ++y) {
+      Code* row = out + y * width;
       for (std::size_t k = 1; k < kBranch; ++k) {
         const std::size_t other = y + k * stride;
-        if (other >= static_cast<std::size_t>(g.height)) break;
-        const float* in = rows.data() + other * width;
+        if (other >= height) break;
+        const Code* in = out + other * width;
         for (std::size_t x = 0; x < width; ++x) row[x] = std::max(row[x], in[x]);
       }
     }
@@ -151,6 +171,9 @@ void check_window(double window, double angle_window, double resolution) {
     throw Error("correlative search: window and resolution must be positive");
 }
 
+/// The scores of a block's children, row by row.
+using ChildScores = std::array<float, 16>;
+
 /// A block of translations (corner x, y in cells from the window's -half, side kSides[level]) at
 /// one rotation, with the upper bound of their scores at that level.
 struct Block {
@@ -161,34 +184,152 @@ bool higher_bound(const Block& a, const Block& b) {
   return a.bound > b.bound;
 }
 
-/// What a search over a window scores: the current scan thinned, the reference's likelihood grid
-/// and the thinned points' cells under each rotation. Empty `cells` when nothing can be scored.
-struct SearchSpace {
-  std::vector<Vec2> points;
-  std::shared_ptr<const LikelihoodGrid> grid_owner;
-  const LikelihoodGrid* grid_ = nullptr;
-  Pose2 initial = Pose2::Identity();
-  double angle_step = 0.0;
-  int angles = 0;              ///< rotations -angles..angles steps about the initial guess
-  int half_x = 0, half_y = 0;  ///< translations -half..half cells about it, along x and y
-  int span_x = 0, span_y = 0;  ///< 2 * half + 1
-  std::vector<std::vector<std::pair<int, int>>> cells;  ///< per rotation, relative to -half
+/// A point's cell on the grid, (x, y).
+using Cell = std::pair<int, int>;
 
-  /// Sum over the points of the level's likelihood, at translation cell (x, y) (0..span-1).
+/// The current scan's thinned points about an initial guess on a reference's likelihood grid, with
+/// the cells they fall in under each rotation the searches looked at (kept for the next search
+/// about the same guess). Rotation a turns the guess by a angular steps.
+class ScanOnGrid {
+ public:
+  ScanOnGrid(std::vector<Vec2> points, double step_range,
+             std::shared_ptr<const LikelihoodGrid> grid, const Pose2& initial)
+      : points_(std::move(points)), grid_(std::move(grid)), initial_(initial) {
+    // Angular step: a point at `step_range` moves by about one cell.
+    angle_step_ = std::clamp(grid_->resolution / std::max(step_range, 1e-3), 0.1 * M_PI / 180,
+                             1.0 * M_PI / 180);
+  }
+  const std::vector<Vec2>& points() const { return points_; }
+  const LikelihoodGrid& grid() const { return *grid_; }
+  const Pose2& initial() const { return initial_; }
+  double angle_step() const { return angle_step_; }
+  /// The rotations -angles..angles steps are available from here on.
+  void prepare(int angles);
+  /// The points' grid cells under rotation `angle` (prepared), at the guess's translation.
+  const std::vector<Cell>& cells(int angle) const {
+    return cells_[static_cast<std::size_t>(angle + angles_)];
+  }
+
+ private:
+  std::vector<Vec2> points_;
+  std::shared_ptr<const LikelihoodGrid> grid_;
+  Pose2 initial_ = Pose2::Identity();
+  double angle_step_ = 0.0;
+  int angles_ = -1;
+  std::vector<std::vector<Cell>> cells_;  ///< by rotation + angles_
+};
+
+void ScanOnGrid::prepare(int angles) {
+  if (angles <= angles_) return;
+  std::vector<std::vector<Cell>> cells(static_cast<std::size_t>(2 * angles + 1));
+  for (int a = -angles_; a <= angles_; ++a)
+    cells[static_cast<std::size_t>(a + angles)] =
+        std::move(cells_[static_cast<std::size_t>(a + angles_)]);
+  // floor() through a shift into positive numbers (a plain conversion truncates): far cheaper
+  // than std::floor, exact within 2^20 cells of the grid; farther (a wild point) is clamped, still
+  // off the grid, where a conversion would overflow.
+  constexpr double kShift = 1 << 20;
+  const auto cell = [&](double v) {
+    return static_cast<int>(std::clamp(v, -kShift, kShift) + kShift) - (1 << 20);
+  };
+  const LikelihoodGrid& g = *grid_;
+  const double r = g.resolution;
+  const Vec2 start = (initial_.translation() - g.origin) / r;
+  for (int a = -angles; a <= angles; ++a) {
+    if (std::abs(a) <= angles_) continue;  // kept from before
+    const double theta = pose2_angle(initial_) + a * angle_step_;
+    const double c = std::cos(theta) / r, s = std::sin(theta) / r;
+    auto& out = cells[static_cast<std::size_t>(a + angles)];
+    out.reserve(points_.size());
+    for (const Vec2& p : points_)
+      out.push_back(
+          {cell(c * p.x() - s * p.y() + start.x()), cell(s * p.x() + c * p.y() + start.y())});
+  }
+  cells_ = std::move(cells);
+  angles_ = angles;
+}
+
+/// What a search over a window scores: rotations -angles..angles steps and translations
+/// -half..half cells about the guess; window cell (x, y) (0..span - 1) is translation
+/// (x - half_x, y - half_y). Without `scan` nothing can be scored.
+struct SearchSpace {
+  ScanOnGrid* scan = nullptr;
+  int angles = 0;
+  int half_x = 0, half_y = 0;
+  int span_x = 0, span_y = 0;  ///< 2 * half + 1
+
+  SearchSpace() = default;
+  SearchSpace(ScanOnGrid& on_grid, const Vec2& window, double angle_window) : scan(&on_grid) {
+    const double r = on_grid.grid().resolution;
+    angles = static_cast<int>(std::ceil(angle_window / on_grid.angle_step()));
+    half_x = static_cast<int>(std::ceil(window.x() / r));
+    half_y = static_cast<int>(std::ceil(window.y() / r));
+    span_x = 2 * half_x + 1;
+    span_y = 2 * half_y + 1;
+    on_grid.prepare(angles);
+  }
+  bool empty() const { return scan == nullptr; }
+  std::size_t points() const { return scan->points().size(); }
+  const LikelihoodGrid& grid() const { return scan->grid(); }
+
+  /// Sum over the points of the level's likelihood, at window cell (x, y).
   float score(int angle, int level, int x, int y) const {
+    const LikelihoodGrid& g = grid();
     float sum = 0.0f;
-    for (const auto& [cx, cy] : cells[static_cast<std::size_t>(angle + angles)])
-      sum += grid_->at(level, cx + x, cy + y);
+    for (const auto& [cx, cy] : scan->cells(angle))
+      sum += g.at(level, cx + (x - half_x), cy + (y - half_y));
     return sum;
   }
-  const LikelihoodGrid& grid() const { return *grid_; }
+  /// The scores of a block's kBranch x kBranch children at `level` (their corners `Side` cells
+  /// apart from window cell (x, y), row by row) in one pass over the points: each child's sum adds
+  /// the same floats in the same order as score() does, so the scores are the same to the bit.
+  template <int Side, int Count = kBranch>
+  void child_scores(int angle, int level, int x, int y, ChildScores& out) const;
+  /// child_scores of the block at `level` (1 to kLevels - 1) with its corner at (x, y).
+  void children(int angle, int level, int x, int y, ChildScores& out) const {
+    using Scores = void (SearchSpace::*)(int, int, int, int, ChildScores&) const;
+    static constexpr auto kByLevel = []<std::size_t... L>(std::index_sequence<L...>) {
+      return std::array<Scores, sizeof...(L)>{&SearchSpace::child_scores<kSides[L]>...};
+    }
+    (std::make_index_sequence<kLevels - 1>());
+    (this->*kByLevel[static_cast<std::size_t>(level - 1)])(angle, level - 1, x, y, out);
+  }
   Pose2 pose(int angle, int x, int y) const {
-    const double r = grid_->resolution;
+    const Pose2& initial = scan->initial();
+    const double r = grid().resolution;
     return pose2(initial.translation().x() + (x - half_x) * r,
                  initial.translation().y() + (y - half_y) * r,
-                 pose2_angle(initial) + angle * angle_step);
+                 pose2_angle(initial) + angle * scan->angle_step());
   }
 };
+
+template <int Side, int Count>
+void SearchSpace::child_scores(int angle, int level, int x, int y, ChildScores& out) const {
+  static_assert(Count * Count <= std::tuple_size_v<ChildScores>);
+  constexpr int kReach = (Count - 1) * Side;  // from the first child's cell to the last's
+  const LikelihoodGrid& g = grid();
+  const Code* data = g.level(level);
+  const std::array<float, kCodes> likelihood = g.likelihood;
+  const int width = g.width, height = g.height;
+  const std::size_t row_step = static_cast<std::size_t>(Side) * static_cast<std::size_t>(width);
+  const int shift_x = x - half_x, shift_y = y - half_y;
+  ChildScores sum{};
+  for (const auto& [cx, cy] : scan->cells(angle)) {
+    const int gx = cx + shift_x, gy = cy + shift_y;
+    if (gx >= 0 && gy >= 0 && gx + kReach < width && gy + kReach < height) {
+      const Code* row = data + static_cast<std::size_t>(gy) * static_cast<std::size_t>(width) +
+                        static_cast<std::size_t>(gx);
+      for (int dy = 0; dy < Count; ++dy, row += row_step)
+        for (int dx = 0; dx < Count; ++dx) sum[dy * Count + dx] += likelihood[row[dx * Side]];
+    } else if (gx + kReach >= 0 && gy + kReach >= 0 && gx < width && gy < height) {
+      // Partly on the grid; off it adds nothing (a zero leaves a float sum as it was).
+      for (int dy = 0; dy < Count; ++dy)
+        for (int dx = 0; dx < Count; ++dx)
+          sum[dy * Count + dx] += g.at(level, gx + dx * Side, gy + dy * Side);
+    }
+  }
+  out = sum;
+}
 
 /// The current scan's points (finite, thinned at `resolution`'s double) and their ranges' 90th
 /// percentile and maximum, for the search's angular step and the grid's footprint.
@@ -223,59 +364,15 @@ SearchPoints search_points(const Scan2D& current, double resolution) {
   return out;
 }
 
-/// The rotations and translations of a search about `initial` onto `grid`, with the cells of the
-/// points under each rotation.
-SearchSpace search_space(SearchPoints&& current, std::shared_ptr<const LikelihoodGrid> grid,
-                         const Pose2& initial, const Vec2& window, double angle_window) {
-  SearchSpace space;
-  space.points = std::move(current.points);
-  const std::vector<Vec2>& points = space.points;
-  space.grid_owner = std::move(grid);
-  space.grid_ = space.grid_owner.get();
-  const LikelihoodGrid& g = *space.grid_;
-  const double r = g.resolution;
-  const double step_range = current.step_range;
-
-  // Angular step: a point at `step_range` moves by about one cell.
-  space.angle_step = std::clamp(r / std::max(step_range, 1e-3), 0.1 * M_PI / 180, 1.0 * M_PI / 180);
-  space.angles = static_cast<int>(std::ceil(angle_window / space.angle_step));
-  space.half_x = static_cast<int>(std::ceil(window.x() / r));  // translations -half..half cells
-  space.half_y = static_cast<int>(std::ceil(window.y() / r));
-  space.span_x = 2 * space.half_x + 1;
-  space.span_y = 2 * space.half_y + 1;
-  space.initial = initial;
-  const int angles = space.angles, half_x = space.half_x, half_y = space.half_y;
-
-  // Cells of the thinned points under each rotation, relative to the window's corner.
-  space.cells.resize(static_cast<std::size_t>(2 * angles + 1));
-  // floor() through a shift into positive numbers (a plain conversion truncates): far cheaper
-  // than std::floor, exact within 2^20 cells of the grid; farther (a wild point) is clamped, still
-  // off the grid, where a conversion would overflow.
-  constexpr double kShift = 1 << 20;
-  const auto cell = [&](double v, int half) {
-    return static_cast<int>(std::clamp(v, -kShift, kShift) + kShift) - (1 << 20) - half;
-  };
-  const Vec2 start = (initial.translation() - g.origin) / r;
-  for (int a = -angles; a <= angles; ++a) {
-    const double theta = pose2_angle(initial) + a * space.angle_step;
-    const double c = std::cos(theta) / r, s = std::sin(theta) / r;
-    auto& out = space.cells[static_cast<std::size_t>(a + angles)];
-    out.reserve(points.size());
-    for (const Vec2& p : points)
-      out.push_back({cell(c * p.x() - s * p.y() + start.x(), half_x),
-                     cell(s * p.x() + c * p.y() + start.y(), half_y)});
-  }
-  return space;
-}
-
-/// A search about `initial` onto `reference`'s filled surfaces where the current scan can land
-/// (its footprint under `initial`, grown by the window and the rotation's sweep). Empty `cells`
-/// when nothing can be scored.
-SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const Pose2& initial,
-                         double window, double angle_window, double resolution, double fill_gap) {
-  if (current.points.empty() || reference.points.empty()) return {};  // nothing to score
+/// The current scan about `initial` onto `reference`'s filled surfaces where it can land (its
+/// footprint under `initial`, grown by the window and the rotation's sweep); none when nothing can
+/// be scored.
+std::optional<ScanOnGrid> scan_on_grid(const Scan2D& current, const Scan2D& reference,
+                                       const Pose2& initial, double window, double angle_window,
+                                       double resolution, double fill_gap) {
+  if (current.points.empty() || reference.points.empty()) return std::nullopt;
   SearchPoints points = search_points(current, resolution);
-  if (points.points.empty()) return {};
+  if (points.points.empty()) return std::nullopt;
   Vec2 low = initial.translation(), high = initial.translation();
   for (const Vec2& p : points.points) {
     const Vec2 q = initial * p;
@@ -289,10 +386,9 @@ SearchSpace search_space(const Scan2D& current, const Scan2D& reference, const P
   std::vector<Vec2> useful;
   for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
     if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
-  if (useful.empty()) return {};
-  return search_space(std::move(points),
-                      std::make_shared<LikelihoodGrid>(make_grid(useful, resolution)), initial,
-                      Vec2::Constant(window), angle_window);
+  if (useful.empty()) return std::nullopt;
+  return ScanOnGrid(std::move(points.points), points.step_range,
+                    std::make_shared<LikelihoodGrid>(make_grid(useful, resolution)), initial);
 }
 
 }  // namespace
@@ -315,12 +411,12 @@ CorrelativeGrid::CorrelativeGrid(const Scan2D& reference, double resolution, dou
 
 namespace {
 
-SearchSpace search_space(const Scan2D& current, const CorrelativeGrid& reference,
-                         const Pose2& initial, const Vec2& window, double angle_window) {
-  if (current.points.empty() || reference.empty()) return {};
+std::optional<ScanOnGrid> scan_on_grid(const Scan2D& current, const CorrelativeGrid& reference,
+                                       const Pose2& initial) {
+  if (current.points.empty() || reference.empty()) return std::nullopt;
   SearchPoints points = search_points(current, reference.resolution());
-  if (points.points.empty()) return {};
-  return search_space(std::move(points), reference.impl().grid, initial, window, angle_window);
+  if (points.points.empty()) return std::nullopt;
+  return ScanOnGrid(std::move(points.points), points.step_range, reference.impl().grid, initial);
 }
 
 }  // namespace
@@ -368,14 +464,61 @@ void check_min_score(double min_score) {
     throw Error("correlative search: the minimum score must be in [0, 1]");
 }
 
-/// correlative_match over a prepared search space.
-CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double min_score) {
+/// A window an earlier search about the same guess looked over, and what it found there: the best
+/// pose (as translation and rotation steps from the guess) with its score and distance from the
+/// guess, or, when not `found`, that nothing there reached `floor`.
+struct SearchedWindow {
+  int angles = 0, half_x = 0, half_y = 0;
+  float floor = 0.0f;
+  bool found = false;
+  float score = 0.0f;
+  double offset = 0.0;
+  int angle = 0, x = 0, y = 0;
+};
+
+/// correlative_match over a prepared search space. Windows searched before (`searched`) that lie
+/// within this one are not looked at again: their best starts as the best so far, and any block
+/// inside one of them can hold no better pose (a tie only nearer the guess, which that search
+/// would have kept). `found` records what this search finds.
+CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double min_score,
+                         const std::vector<SearchedWindow>& searched = {},
+                         SearchedWindow* found = nullptr) {
   CorrelativeMatch match;
   match.pose = initial;
-  if (space.cells.empty()) return match;
-  const std::vector<Vec2>& points = space.points;
+  if (space.empty()) return match;
   const int angles = space.angles, half_x = space.half_x, half_y = space.half_y,
             span_x = space.span_x, span_y = space.span_y;
+  // Below the minimum nothing counts, so the bounds prune from the start.
+  const float floor = static_cast<float>(min_score * static_cast<double>(space.points()));
+  float best = floor;
+  int best_a = 0, best_x = half_x, best_y = half_y;
+  double best_offset = std::numeric_limits<double>::infinity();
+  // The earlier windows inside this one whose every pose is known: each found its best, or found
+  // nothing at or above a floor no higher than this one.
+  std::vector<const SearchedWindow*> known;
+  for (const SearchedWindow& w : searched) {
+    if (w.angles > angles || w.half_x > half_x || w.half_y > half_y) continue;
+    if (!w.found && w.floor > floor) continue;
+    known.push_back(&w);
+    if (w.found && (w.score > best || (w.score == best && w.offset < best_offset))) {
+      best = w.score;
+      best_offset = w.offset;
+      best_a = w.angle;
+      best_x = w.x + half_x;
+      best_y = w.y + half_y;
+    }
+  }
+  // Whether all of a block's poses lie in a known window.
+  const auto known_block = [&](int angle, int level, int x, int y) {
+    const int side = kSides[static_cast<std::size_t>(level)];
+    const int x0 = x - half_x, x1 = std::min(x + side, span_x) - 1 - half_x;
+    const int y0 = y - half_y, y1 = std::min(y + side, span_y) - 1 - half_y;
+    for (const SearchedWindow* w : known)
+      if (std::abs(angle) <= w->angles && x0 >= -w->half_x && x1 <= w->half_x && y0 >= -w->half_y &&
+          y1 <= w->half_y)
+        return true;
+    return false;
+  };
   // Branch and bound, depth first: a block of translations is bounded by its level's maxima; the
   // children of the most promising blocks are looked at first, so the best score found early
   // dismisses most of the window. Exact at the finest level; ties go to the translation nearest
@@ -390,12 +533,9 @@ CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double 
   std::vector<Block> blocks;
   for (int a = -angles; a <= angles; ++a)
     for (int y = 0; y < span_y; y += top_side)
-      for (int x = 0; x < span_x; x += top_side) blocks.push_back(bound_of(a, top, x, y));
+      for (int x = 0; x < span_x; x += top_side)
+        if (!known_block(a, top, x, y)) blocks.push_back(bound_of(a, top, x, y));
   std::sort(blocks.begin(), blocks.end(), higher_bound);
-  // Below the minimum nothing counts, so the bounds prune from the start.
-  float best = static_cast<float>(min_score * static_cast<double>(points.size()));
-  int best_a = 0, best_x = half_x, best_y = half_y;
-  double best_offset = std::numeric_limits<double>::infinity();
   // A pose's exact score at the finest level; kept when it beats the best so far, or ties it
   // nearer the guess.
   const auto consider = [&](const Block& leaf) {
@@ -409,8 +549,9 @@ CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double 
     best_y = leaf.y;
   };
   // A good score early prunes most of the tree: climb from the guess (where odometry's constant
-  // velocity guess and a loop's estimate usually lie close) before branching.
-  {
+  // velocity guess and a loop's estimate usually lie close) before branching. A known window
+  // holds the guess and gave its best already.
+  if (known.empty()) {
     Block here = bound_of(0, 0, half_x, half_y);
     consider(here);
     for (int step = 0; step < 32; ++step) {
@@ -435,17 +576,23 @@ CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double 
       consider(block);
       return;
     }
-    const int side = kSides[static_cast<std::size_t>(block.level - 1)];
+    const int level = block.level - 1, side = kSides[static_cast<std::size_t>(level)];
+    ChildScores scores;
+    space.children(block.angle, block.level, block.x, block.y, scores);
     std::array<Block, kBranch * kBranch> next;
     std::size_t count = 0;
     for (int dy = 0; dy < kBranch; ++dy)
       for (int dx = 0; dx < kBranch; ++dx) {
         const int x = block.x + dx * side, y = block.y + dy * side;
-        if (x < span_x && y < span_y) next[count++] = bound_of(block.angle, block.level - 1, x, y);
+        if (x < span_x && y < span_y)
+          next[count++] =
+              Block{scores[static_cast<std::size_t>(dy * kBranch + dx)], block.angle, level, x, y};
       }
     std::sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(count), higher_bound);
     for (std::size_t i = 0; i < count; ++i) {
       if (next[i].bound < best) break;
+      if (level > 0 && !known.empty() && known_block(next[i].angle, level, next[i].x, next[i].y))
+        continue;
       self(self, next[i]);
     }
   };
@@ -453,23 +600,57 @@ CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double 
     if (block.bound < best) break;
     descend(descend, block);
   }
-  if (!std::isfinite(best_offset)) return match;  // nothing reached the minimum score
+  const bool any = std::isfinite(best_offset);
+  if (found != nullptr)
+    *found = SearchedWindow{angles, half_x,      half_y, floor,           any,
+                            best,   best_offset, best_a, best_x - half_x, best_y - half_y};
+  if (!any) return match;  // nothing reached the minimum score
   match.found = true;
-  match.score = best / static_cast<double>(points.size());
+  match.score = best / static_cast<double>(space.points());
   match.pose = space.pose(best_a, best_x, best_y);
   return match;
 }
 
 }  // namespace
 
+struct CorrelativeSearches::State {
+  std::optional<ScanOnGrid> scan;
+  Pose2 initial = Pose2::Identity();
+  double resolution = 0.05;
+  std::vector<SearchedWindow> searched;
+};
+
+CorrelativeSearches::CorrelativeSearches(const Scan2D& current, const CorrelativeGrid& reference,
+                                         const Pose2& initial)
+    : state_(std::make_unique<State>()) {
+  state_->scan = scan_on_grid(current, reference, initial);
+  state_->initial = initial;
+  state_->resolution = reference.resolution();
+}
+
+CorrelativeSearches::~CorrelativeSearches() = default;
+
+CorrelativeMatch CorrelativeSearches::match(const Eigen::Vector2d& window, double angle_window,
+                                            double min_score) {
+  check_window(std::min(window.x(), window.y()), angle_window, state_->resolution);
+  check_min_score(min_score);
+  if (!state_->scan) return best_in(SearchSpace(), state_->initial, min_score);
+  SearchedWindow found;
+  const CorrelativeMatch match = best_in(SearchSpace(*state_->scan, window, angle_window),
+                                         state_->initial, min_score, state_->searched, &found);
+  state_->searched.push_back(found);
+  return match;
+}
+
 CorrelativeMatch correlative_match(const Scan2D& current, const Scan2D& reference,
                                    const Pose2& initial, double window, double angle_window,
                                    double resolution, double fill_gap, double min_score) {
   check_window(window, angle_window, resolution);
   check_min_score(min_score);
-  return best_in(
-      search_space(current, reference, initial, window, angle_window, resolution, fill_gap),
-      initial, min_score);
+  std::optional<ScanOnGrid> scan =
+      scan_on_grid(current, reference, initial, window, angle_window, resolution, fill_gap);
+  if (!scan) return best_in(SearchSpace(), initial, min_score);
+  return best_in(SearchSpace(*scan, Vec2::Constant(window), angle_window), initial, min_score);
 }
 
 CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid& reference,
@@ -482,10 +663,7 @@ CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid&
 CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid& reference,
                                    const Pose2& initial, const Eigen::Vector2d& window,
                                    double angle_window, double min_score) {
-  check_window(std::min(window.x(), window.y()), angle_window, reference.resolution());
-  check_min_score(min_score);
-  return best_in(search_space(current, reference, initial, window, angle_window), initial,
-                 min_score);
+  return CorrelativeSearches(current, reference, initial).match(window, angle_window, min_score);
 }
 
 namespace {
@@ -499,13 +677,15 @@ CorrelativeSpread spread_in(const SearchSpace& space, const Pose2& at, double ma
                             const std::optional<Eigen::Vector2d>& toward) {
   CorrelativeSpread spread;
   spread.nearest = at;
-  if (space.cells.empty()) return spread;
+  if (space.empty()) return spread;
   // Each translation's best rotation. Blocks of 4 x 4 translations are bounded by the grid's first
   // max-filtered level and looked at best first; once a block's bound falls below the best found
   // less the margin, no translation in it or in any later block can count.
-  const double points = static_cast<double>(space.points.size());
+  const double points = static_cast<double>(space.points());
   const float allowance = static_cast<float>(margin * points);
-  constexpr int kLevel = 1, kSide = kSides[kLevel];
+  constexpr int kSide = 4;
+  constexpr int kLevel =
+      static_cast<int>(std::find(kSides.begin(), kSides.end(), kSide) - kSides.begin());
   std::vector<Block> blocks;
   for (int a = -space.angles; a <= space.angles; ++a)
     for (int y = 0; y < space.span_y; y += kSide)
@@ -516,12 +696,14 @@ CorrelativeSpread spread_in(const SearchSpace& space, const Pose2& at, double ma
   std::vector<float> best_of(cells, 0.0f);
   std::vector<int> best_angle(cells, 0);
   float best = 0.0f;
+  ChildScores scores;
   for (const Block& block : blocks) {
     if (block.bound < best - allowance) break;
+    space.child_scores<1, kSide>(block.angle, 0, block.x, block.y, scores);
     for (int y = block.y; y < std::min(block.y + kSide, space.span_y); ++y)
       for (int x = block.x; x < std::min(block.x + kSide, space.span_x); ++x) {
         const auto i = static_cast<std::size_t>(y * space.span_x + x);
-        const float score = space.score(block.angle, 0, x, y);
+        const float score = scores[static_cast<std::size_t>((y - block.y) * kSide + x - block.x)];
         if (score > best_of[i]) {
           best_of[i] = score;
           best_angle[i] = block.angle;
@@ -560,8 +742,10 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const Scan2D& refere
                                      const std::optional<Eigen::Vector2d>& toward) {
   check_window(window, angle_window, resolution);
   check_margin(margin);
-  return spread_in(search_space(current, reference, at, window, angle_window, resolution, fill_gap),
-                   at, margin, toward);
+  std::optional<ScanOnGrid> scan =
+      scan_on_grid(current, reference, at, window, angle_window, resolution, fill_gap);
+  if (!scan) return spread_in(SearchSpace(), at, margin, toward);
+  return spread_in(SearchSpace(*scan, Vec2::Constant(window), angle_window), at, margin, toward);
 }
 
 CorrelativeSpread correlative_spread(const Scan2D& current, const CorrelativeGrid& reference,
@@ -569,8 +753,9 @@ CorrelativeSpread correlative_spread(const Scan2D& current, const CorrelativeGri
                                      double margin, const std::optional<Eigen::Vector2d>& toward) {
   check_window(window, angle_window, reference.resolution());
   check_margin(margin);
-  return spread_in(search_space(current, reference, at, Vec2::Constant(window), angle_window), at,
-                   margin, toward);
+  std::optional<ScanOnGrid> scan = scan_on_grid(current, reference, at);
+  if (!scan) return spread_in(SearchSpace(), at, margin, toward);
+  return spread_in(SearchSpace(*scan, Vec2::Constant(window), angle_window), at, margin, toward);
 }
 
 SpreadAxis widest_spread(const CorrelativeSpread& spread) {

@@ -73,6 +73,26 @@ CorrelativeMatch correlative_match(const Scan2D& current, const CorrelativeGrid&
                                    const Pose2& initial, const Eigen::Vector2d& window,
                                    double angle_window, double min_score = 0.0);
 
+/// Several correlative_match searches of one scan about one guess onto one grid, each window
+/// holding the ones before (the odometry's narrow, wide, whole-turn and long searches): the scan is
+/// prepared once, and a search looks again at no earlier window that lies inside its own (it
+/// starts from the best found there). Each search returns what correlative_match would.
+class CorrelativeSearches {
+ public:
+  CorrelativeSearches(const Scan2D& current, const CorrelativeGrid& reference,
+                      const Pose2& initial);
+  ~CorrelativeSearches();
+  CorrelativeSearches(const CorrelativeSearches&) = delete;
+  CorrelativeSearches& operator=(const CorrelativeSearches&) = delete;
+  /// correlative_match over +- window.x() and +- window.y() (m) and +- `angle_window` (rad).
+  CorrelativeMatch match(const Eigen::Vector2d& window, double angle_window,
+                         double min_score = 0.0);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
 /// How much a scan's translation is left open at a pose (`at`, current in the reference's frame):
 /// the translations within +- `window` (m) of it, each at its best rotation within
 /// +- `angle_window` (rad), that score within `margin` (a share) of the window's best.
