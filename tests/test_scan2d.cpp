@@ -377,6 +377,26 @@ TEST(Scan2D, CorrelativeGridServesEverySearchOntoItsReference) {
                Error);
 }
 
+TEST(Scan2D, CorrelativeMatchFindsTheBestScoreOfAnExhaustiveSearch) {
+  // The branch and bound prunes blocks of poses by bounds summed from the grid's coarse levels;
+  // the spread with a margin of every point scores every pose of its window (nothing can be
+  // pruned), so its best is the exhaustive search's. Guesses 0.3 m and 0.2 rad off the truth.
+  for (const sim::PlanarScanPair& laser : pairs(scanmatch::testing::sanitized() ? 3 : 10)) {
+    const Scan2D reference = scan_from_laser(laser.reference),
+                 current = scan_from_laser(laser.current);
+    for (const double resolution : {0.05, 0.1}) {
+      const CorrelativeGrid grid(reference, resolution, 1.0);
+      for (const Pose2& guess : {laser.truth, pose2(0.3, -0.2, 0.2) * laser.truth}) {
+        const CorrelativeMatch match = correlative_match(current, grid, guess, 0.5, 0.3);
+        const CorrelativeSpread all = correlative_spread(current, grid, guess, 0.5, 0.3, 1.0);
+        ASSERT_TRUE(match.found);
+        EXPECT_EQ(match.score, all.best_score) << resolution;
+        EXPECT_LT((match.pose.translation() - laser.truth.translation()).norm(), 2 * resolution);
+      }
+    }
+  }
+}
+
 TEST(Scan2D, CorrelativeSearchesFindWhatEachSearchFindsAlone) {
   // The odometry's searches about one guess (narrow, wide, whole turn, long), each from the best
   // score so far: the later ones skip the earlier windows but return what a search of their whole

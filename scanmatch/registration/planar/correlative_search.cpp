@@ -12,6 +12,10 @@
 
 #include "scanmatch/core/error.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace scanmatch {
 namespace {
 
@@ -33,32 +37,36 @@ static_assert(kTopSide == 64);
 constexpr std::int64_t kMaxCellsPerLevel = 4'000'000;
 
 /// The smoothing kernel: a Gaussian of sigma = one cell around each reference point, out to
-/// kRadius cells. Its values are few (one per squared distance), so a cell holds a code: 0 off
-/// every surface, then the kernel's values in increasing order, so that the maximum of codes is the
-/// code of the maximum. A quarter of the floats' memory (the searches' reads miss the cache less)
-/// and the same sums to the bit.
+/// kRadius cells. Its values are few (one per squared distance), so a cell holds a byte, the code
+/// of its value v: ceil(255 v), 0 off every surface. The codes grow with the values, so the maximum
+/// of codes is the code of the maximum. A quarter of the floats' memory (the searches' reads miss
+/// the cache less); a pose's score sums the floats the codes stand for, in the points' order (the
+/// same sums to the bit), while a block's bound sums the codes themselves as integers (four lanes
+/// at once), which bound those floats from above.
 constexpr int kRadius = 2;
 using Code = std::uint8_t;
-constexpr int kCodes = 7;  // zero and one per squared distance 0, 1, 2, 4, 5, 8
+constexpr int kCodeScale = 255;
 
 struct LikelihoodGrid {
   double resolution = 0.05;
   Vec2 origin = Vec2::Zero();  ///< world position of cell (0, 0)'s corner
   int width = 0, height = 0;
-  std::array<float, kCodes> likelihood{};  ///< by code
+  std::array<float, kCodeScale + 1> likelihood{};  ///< by code
   /// Level k's codes start at k * cells(): level 0 is the smoothed likelihood; level k's (x, y) is
-  /// the maximum of level 0 over the square of side kBranch^k from (x, y) towards +x and +y.
+  /// the maximum of level 0 over the square of side kBranch^k from (x, y) towards +x and +y. A
+  /// few bytes more at the end, so that 16 can be read from any cell.
   std::vector<Code> codes;
 
   std::size_t cells() const {
     return static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   }
   const Code* level(int k) const { return codes.data() + static_cast<std::size_t>(k) * cells(); }
-  float at(int k, int x, int y) const {
-    if (x < 0 || y < 0 || x >= width || y >= height) return 0.0f;
-    return likelihood[level(k)[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                               static_cast<std::size_t>(x)]];
+  Code code(int k, int x, int y) const {
+    if (x < 0 || y < 0 || x >= width || y >= height) return 0;
+    return level(k)[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                    static_cast<std::size_t>(x)];
   }
+  float at(int k, int x, int y) const { return likelihood[code(k, x, y)]; }
 };
 
 /// The grid spans the reference points only: a current point landing elsewhere scores nothing.
@@ -86,19 +94,16 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
   g.height = static_cast<int>(std::ceil(size.y() / resolution)) + 1;
   const std::size_t n = g.cells();
   const std::size_t width = static_cast<std::size_t>(g.width);
-  g.codes.assign(n * kLevels, 0);
+  g.codes.assign(n * kLevels + 16, 0);
   Code* fine = g.codes.data();
-  // Kernel values by squared distance, in increasing order, and each offset's code.
-  constexpr std::array<int, kCodes - 1> kSquaredDistances = {8, 5, 4, 2, 1, 0};
+  // Each offset's code; the float it stands for (exactly: 255 v is exact in a double).
   Code kernel[2 * kRadius + 1][2 * kRadius + 1];
-  for (std::size_t c = 1; c < kCodes; ++c)
-    g.likelihood[c] = static_cast<float>(std::exp(-0.5 * kSquaredDistances[c - 1]));
   for (int dy = -kRadius; dy <= kRadius; ++dy)
     for (int dx = -kRadius; dx <= kRadius; ++dx) {
-      const auto code =
-          std::find(kSquaredDistances.begin(), kSquaredDistances.end(), dx * dx + dy * dy) -
-          kSquaredDistances.begin() + 1;
-      kernel[dy + kRadius][dx + kRadius] = static_cast<Code>(code);
+      const float value = static_cast<float>(std::exp(-0.5 * (dx * dx + dy * dy)));
+      const auto code = static_cast<Code>(std::ceil(kCodeScale * static_cast<double>(value)));
+      kernel[dy + kRadius][dx + kRadius] = code;
+      g.likelihood[code] = value;
     }
   for (const Vec2& p : reference) {
     const int cx = static_cast<int>(std::floor((p.x() - low.x()) / resolution));
@@ -139,6 +144,7 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
       }
     }
   }
+  static_assert(kLevels == 4 && kBranch == 4, "the bounds read levels 1 and 2 as 4 x 4 children");
   return g;
 }
 
@@ -272,27 +278,43 @@ struct SearchSpace {
   std::size_t points() const { return scan->points().size(); }
   const LikelihoodGrid& grid() const { return scan->grid(); }
 
-  /// Sum over the points of the level's likelihood, at window cell (x, y).
+  /// At level 0, the pose's score at window cell (x, y): the sum over the points of the
+  /// likelihood. Above, a bound of the scores of the block from there (its side: the level's).
   float score(int angle, int level, int x, int y) const {
     const LikelihoodGrid& g = grid();
-    float sum = 0.0f;
+    const int shift_x = x - half_x, shift_y = y - half_y;
+    if (level == 0) {
+      float sum = 0.0f;
+      for (const auto& [cx, cy] : scan->cells(angle)) sum += g.at(0, cx + shift_x, cy + shift_y);
+      return sum;
+    }
+    std::uint32_t sum = 0;
     for (const auto& [cx, cy] : scan->cells(angle))
-      sum += g.at(level, cx + (x - half_x), cy + (y - half_y));
-    return sum;
+      sum += g.code(level, cx + shift_x, cy + shift_y);
+    return bound(sum);
+  }
+  /// A sum of codes as a bound of the scores' floats: above the exact sum of the values they
+  /// stand for by the float rounding of a sum of points() terms and of the conversion.
+  float bound(std::uint32_t codes) const {
+    const double scale =
+        (1.0 + static_cast<double>(points() + 4) * std::ldexp(1.0, -23)) / kCodeScale;
+    return static_cast<float>(codes * scale);
   }
   /// The scores of a block's kBranch x kBranch children at `level` (their corners `Side` cells
   /// apart from window cell (x, y), row by row) in one pass over the points: each child's sum adds
   /// the same floats in the same order as score() does, so the scores are the same to the bit.
   template <int Side, int Count = kBranch>
   void child_scores(int angle, int level, int x, int y, ChildScores& out) const;
-  /// child_scores of the block at `level` (1 to kLevels - 1) with its corner at (x, y).
+  /// The bounds of a level-2 block's children (level 1, corners 4 cells apart) and of a top
+  /// block's (level 2, 16 apart), as score() gives them, from their codes summed four at once.
+  void level1_bounds(int angle, int x, int y, ChildScores& out) const;
+  void level2_bounds(int angle, int x, int y, ChildScores& out) const;
+  /// The scores (level 1: of the poses) or bounds of the children of the block at `level` (1 to
+  /// kLevels - 1) with its corner at (x, y), row by row.
   void children(int angle, int level, int x, int y, ChildScores& out) const {
-    using Scores = void (SearchSpace::*)(int, int, int, int, ChildScores&) const;
-    static constexpr auto kByLevel = []<std::size_t... L>(std::index_sequence<L...>) {
-      return std::array<Scores, sizeof...(L)>{&SearchSpace::child_scores<kSides[L]>...};
-    }
-    (std::make_index_sequence<kLevels - 1>());
-    (this->*kByLevel[static_cast<std::size_t>(level - 1)])(angle, level - 1, x, y, out);
+    if (level == 1) return child_scores<1>(angle, 0, x, y, out);
+    if (level == 2) return level1_bounds(angle, x, y, out);
+    level2_bounds(angle, x, y, out);
   }
   Pose2 pose(int angle, int x, int y) const {
     const Pose2& initial = scan->initial();
@@ -309,7 +331,7 @@ void SearchSpace::child_scores(int angle, int level, int x, int y, ChildScores& 
   constexpr int kReach = (Count - 1) * Side;  // from the first child's cell to the last's
   const LikelihoodGrid& g = grid();
   const Code* data = g.level(level);
-  const std::array<float, kCodes> likelihood = g.likelihood;
+  const std::array<float, kCodeScale + 1>& likelihood = g.likelihood;
   const int width = g.width, height = g.height;
   const std::size_t row_step = static_cast<std::size_t>(Side) * static_cast<std::size_t>(width);
   const int shift_x = x - half_x, shift_y = y - half_y;
@@ -329,6 +351,85 @@ void SearchSpace::child_scores(int angle, int level, int x, int y, ChildScores& 
     }
   }
   out = sum;
+}
+
+// Sums of the codes of 4 x 4 children, a row of four per lane group: with SSE2 four at once.
+#if defined(__SSE2__)
+struct RowSums {
+  __m128i rows[kBranch] = {_mm_setzero_si128(), _mm_setzero_si128(), _mm_setzero_si128(),
+                           _mm_setzero_si128()};
+  /// Adds lane k of `codes` (4 x 32 bits, codes in the low bytes) to child (k, dy).
+  void add(int dy, __m128i codes) { rows[dy] = _mm_add_epi32(rows[dy], codes); }
+  std::array<std::uint32_t, 16> sums() const {
+    std::array<std::uint32_t, 16> out;
+    for (std::size_t dy = 0; dy < kBranch; ++dy)
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out.data() + 4 * dy), rows[dy]);
+    return out;
+  }
+};
+#endif
+
+void SearchSpace::level1_bounds(int angle, int x, int y, ChildScores& out) const {
+  constexpr int kSide = kSides[1], kReach = (kBranch - 1) * kSide;
+  const LikelihoodGrid& g = grid();
+  const Code* data = g.level(1);
+  const int width = g.width, height = g.height;
+  const std::size_t row_step = static_cast<std::size_t>(kSide) * static_cast<std::size_t>(width);
+  const int shift_x = x - half_x, shift_y = y - half_y;
+  std::array<std::uint32_t, 16> sum{};
+#if defined(__SSE2__)
+  RowSums rows;
+  const __m128i low_bytes = _mm_set1_epi32(0xFF);
+#endif
+  for (const auto& [cx, cy] : scan->cells(angle)) {
+    const int gx = cx + shift_x, gy = cy + shift_y;
+    if (gx >= 0 && gy >= 0 && gx + kReach < width && gy + kReach < height) {
+      const Code* row = data + static_cast<std::size_t>(gy) * static_cast<std::size_t>(width) +
+                        static_cast<std::size_t>(gx);
+      for (int dy = 0; dy < kBranch; ++dy, row += row_step) {
+#if defined(__SSE2__)
+        // 16 bytes from the first child's cell: each 32-bit lane's low byte is a child's.
+        rows.add(dy,
+                 _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row)), low_bytes));
+#else
+        for (int dx = 0; dx < kBranch; ++dx) sum[dy * kBranch + dx] += row[dx * kSide];
+#endif
+      }
+    } else if (gx + kReach >= 0 && gy + kReach >= 0 && gx < width && gy < height) {
+      for (int dy = 0; dy < kBranch; ++dy)
+        for (int dx = 0; dx < kBranch; ++dx)
+          sum[dy * kBranch + dx] += g.code(1, gx + dx * kSide, gy + dy * kSide);
+    }
+  }
+#if defined(__SSE2__)
+  const std::array<std::uint32_t, 16> lanes = rows.sums();
+  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += lanes[i];
+#endif
+  for (std::size_t i = 0; i < sum.size(); ++i) out[i] = bound(sum[i]);
+}
+
+void SearchSpace::level2_bounds(int angle, int x, int y, ChildScores& out) const {
+  constexpr int kSide = kSides[2], kReach = (kBranch - 1) * kSide;
+  const LikelihoodGrid& g = grid();
+  const Code* data = g.level(2);
+  const int width = g.width, height = g.height;
+  const std::size_t row_step = static_cast<std::size_t>(kSide) * static_cast<std::size_t>(width);
+  const int shift_x = x - half_x, shift_y = y - half_y;
+  std::array<std::uint32_t, 16> sum{};
+  for (const auto& [cx, cy] : scan->cells(angle)) {
+    const int gx = cx + shift_x, gy = cy + shift_y;
+    if (gx >= 0 && gy >= 0 && gx + kReach < width && gy + kReach < height) {
+      const Code* row = data + static_cast<std::size_t>(gy) * static_cast<std::size_t>(width) +
+                        static_cast<std::size_t>(gx);
+      for (int dy = 0; dy < kBranch; ++dy, row += row_step)
+        for (int dx = 0; dx < kBranch; ++dx) sum[dy * kBranch + dx] += row[dx * kSide];
+    } else if (gx + kReach >= 0 && gy + kReach >= 0 && gx < width && gy < height) {
+      for (int dy = 0; dy < kBranch; ++dy)
+        for (int dx = 0; dx < kBranch; ++dx)
+          sum[dy * kBranch + dx] += g.code(2, gx + dx * kSide, gy + dy * kSide);
+    }
+  }
+  for (std::size_t i = 0; i < sum.size(); ++i) out[i] = bound(sum[i]);
 }
 
 /// The current scan's points (finite, thinned at `resolution`'s double) and their ranges' 90th
