@@ -119,23 +119,36 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
   // Each level from the one below: the maximum of kBranch cells `stride` apart along +x, then, in
   // place, along +y (row y reads only rows after it, not yet overwritten). Off the grid counts as
   // zero; written branch-free over whole rows so that it vectorizes.
+  static_assert(kBranch == 4, "four cells a pass");
   const std::size_t height = static_cast<std::size_t>(g.height);
   std::size_t stride = 1;
   for (std::size_t level = 1; level < kLevels; ++level, stride *= kBranch) {
     const Code* below = g.codes.data() + (level - 1) * n;
     Code* out = g.codes.data() + level * n;
+    const std::size_t reach = std::min((kBranch - 1) * stride, width);
     for (std::size_t y = 0; y < height; ++y) {
       const Code* in = below + y * width;
       Code* row = out + y * width;
-      std::copy(in, in + width, row);
-      for (std::size_t k = 1; k < kBranch && k * stride < width; ++k) {
-        const Code* shifted = in + k * stride;
-        const std::size_t count = width - k * stride;
-        for (std::size_t x = 0; x < count; ++x) row[x] = std::max(row[x], shifted[x]);
+      // Where all kBranch cells lie on the row in one pass; towards its end, fewer.
+      for (std::size_t x = 0; x + reach < width; ++x)
+        row[x] = std::max(std::max(in[x], in[x + stride]),
+                          std::max(in[x + 2 * stride], in[x + 3 * stride]));
+      for (std::size_t x = width - reach; x < width; ++x) {
+        Code m = in[x];
+        for (std::size_t k = 1; k < kBranch && x + k * stride < width; ++k)
+          m = std::max(m, in[x + k * stride]);
+        row[x] = m;
       }
     }
     for (std::size_t y = 0; y < height; ++y) {
       Code* row = out + y * width;
+      if (y + 3 * stride < height) {
+        const Code *a = row + stride * width, *b = row + 2 * stride * width,
+                   *c = row + 3 * stride * width;
+        for (std::size_t x = 0; x < width; ++x)
+          row[x] = std::max(std::max(row[x], a[x]), std::max(b[x], c[x]));
+        continue;
+      }
       for (std::size_t k = 1; k < kBranch; ++k) {
         const std::size_t other = y + k * stride;
         if (other >= height) break;
