@@ -645,10 +645,38 @@ CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double 
   while (top > 0 && kSides[static_cast<std::size_t>(top - 1)] >= std::max(span_x, span_y)) --top;
   const int top_side = kSides[static_cast<std::size_t>(top)];
   std::vector<Block> blocks;
-  for (int a = -angles; a <= angles; ++a)
-    for (int y = 0; y < span_y; y += top_side)
-      for (int x = 0; x < span_x; x += top_side)
+  // Blocks over the cells x_low..x_high, y_low..y_high (inclusive), laid from the high end down
+  // where `from_high`: a block that reached into a known window would hold its best and never be
+  // pruned. Blocks may start before the window (negative corners) or end after it.
+  const auto tile = [&](int a, int x_low, int x_high, bool x_from_high, int y_low, int y_high,
+                        bool y_from_high) {
+    if (x_low > x_high || y_low > y_high) return;
+    const int x_start = x_from_high ? x_high - top_side + 1 : x_low;
+    const int y_start = y_from_high ? y_high - top_side + 1 : y_low;
+    for (int y = y_start; y + top_side > y_low && y <= y_high;
+         y += y_from_high ? -top_side : top_side)
+      for (int x = x_start; x + top_side > x_low && x <= x_high;
+           x += x_from_high ? -top_side : top_side)
         if (!known_block(a, top, x, y)) blocks.push_back(bound_of(a, top, x, y));
+  };
+  for (int a = -angles; a <= angles; ++a) {
+    // The largest known window at this rotation: the blocks tile the window around it.
+    const SearchedWindow* inner = nullptr;
+    for (const SearchedWindow* w : known)
+      if (std::abs(a) <= w->angles &&
+          (inner == nullptr || w->half_x * w->half_y > inner->half_x * inner->half_y))
+        inner = w;
+    if (inner == nullptr) {
+      tile(a, 0, span_x - 1, false, 0, span_y - 1, false);
+      continue;
+    }
+    const int x0 = half_x - inner->half_x, x1 = half_x + inner->half_x;
+    const int y0 = half_y - inner->half_y, y1 = half_y + inner->half_y;
+    tile(a, 0, x0 - 1, true, 0, span_y - 1, false);            // before it along x
+    tile(a, x1 + 1, span_x - 1, false, 0, span_y - 1, false);  // after it
+    tile(a, x0, x1, false, 0, y0 - 1, true);                   // before it along y
+    tile(a, x0, x1, false, y1 + 1, span_y - 1, false);         // after it
+  }
   std::sort(blocks.begin(), blocks.end(), higher_bound);
   // A pose's exact score at the finest level; kept when it beats the best so far, or ties it
   // nearer the guess.
@@ -698,7 +726,7 @@ CorrelativeMatch best_in(const SearchSpace& space, const Pose2& initial, double 
     for (int dy = 0; dy < kBranch; ++dy)
       for (int dx = 0; dx < kBranch; ++dx) {
         const int x = block.x + dx * side, y = block.y + dy * side;
-        if (x < span_x && y < span_y)
+        if (x + side > 0 && y + side > 0 && x < span_x && y < span_y)
           next[count++] =
               Block{scores[static_cast<std::size_t>(dy * kBranch + dx)], block.angle, level, x, y};
       }
