@@ -828,11 +828,27 @@ CorrelativeSpread spread_in(const SearchSpace& space, const Pose2& at, double ma
   constexpr int kSide = 4;
   constexpr int kLevel =
       static_cast<int>(std::find(kSides.begin(), kSides.end(), kSide) - kSides.begin());
+  static_assert(kLevel == 1, "the blocks' bounds come 16 at a time, as a level-2 block's children");
+  // Each rotation's blocks, row by row (the order score() would give them in, one at a time).
+  const int columns = (space.span_x + kSide - 1) / kSide, rows = (space.span_y + kSide - 1) / kSide;
   std::vector<Block> blocks;
-  for (int a = -space.angles; a <= space.angles; ++a)
+  blocks.reserve(static_cast<std::size_t>((2 * space.angles + 1) * columns * rows));
+  std::vector<float> bounds(static_cast<std::size_t>(columns * rows));
+  ChildScores children;
+  for (int a = -space.angles; a <= space.angles; ++a) {
+    for (int y = 0; y < space.span_y; y += kBranch * kSide)
+      for (int x = 0; x < space.span_x; x += kBranch * kSide) {
+        space.level1_bounds(a, x, y, children);
+        for (int dy = 0; dy < kBranch && y + dy * kSide < space.span_y; ++dy)
+          for (int dx = 0; dx < kBranch && x + dx * kSide < space.span_x; ++dx)
+            bounds[static_cast<std::size_t>((y / kSide + dy) * columns + x / kSide + dx)] =
+                children[static_cast<std::size_t>(dy * kBranch + dx)];
+      }
     for (int y = 0; y < space.span_y; y += kSide)
       for (int x = 0; x < space.span_x; x += kSide)
-        blocks.push_back({space.score(a, kLevel, x, y), a, kLevel, x, y});
+        blocks.push_back(
+            {bounds[static_cast<std::size_t>(y / kSide * columns + x / kSide)], a, kLevel, x, y});
+  }
   std::sort(blocks.begin(), blocks.end(), higher_bound);
   const auto cells = static_cast<std::size_t>(space.span_x * space.span_y);
   std::vector<float> best_of(cells, 0.0f);
