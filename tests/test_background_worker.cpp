@@ -62,6 +62,34 @@ TEST(BackgroundWorker, AFullQueueHoldsTheCallerBack) {
   EXPECT_GT(worker.waited_ms(), 0.0);
 }
 
+TEST(BackgroundWorker, TheQueueIsBoundedByWeightAndTakesAHeavyItemWhenEmpty) {
+  // Items weigh their value; the queue holds 10. A heavier item still goes into an empty queue
+  // (nothing would ever make room for it), lighter ones queue until 10 and the next one waits.
+  std::atomic<bool> release{false};
+  std::atomic<int> done{0};
+  BackgroundWorker<int> worker(
+      [&](int&) {
+        while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        ++done;
+      },
+      10, true, [](const int& i) { return static_cast<std::size_t>(i); });
+  worker.push(100);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the worker holds it
+  for (int i = 0; i < 3; ++i) worker.push(3);                  // 9 of 10 queued
+  std::atomic<bool> pushed{false};
+  std::thread caller([&] {
+    worker.push(3);
+    pushed = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(pushed.load());
+  release = true;
+  caller.join();
+  worker.finish();
+  EXPECT_TRUE(pushed.load());
+  EXPECT_EQ(done.load(), 5);
+}
+
 TEST(BackgroundWorker, TheWorksExceptionReachesTheCaller) {
   BackgroundWorker<int> worker([](int& i) {
     if (i == 5) throw std::runtime_error("item 5 is bad");

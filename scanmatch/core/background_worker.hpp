@@ -19,12 +19,17 @@ namespace scanmatch {
 template <typename Item>
 class BackgroundWorker {
  public:
-  /// `work` runs on the worker thread for each pushed item. push() waits while `capacity` items
-  /// are queued (0: never), so a worker slower than the caller holds it back instead of queueing
-  /// the whole input. With `background` false the work runs inside push() (no thread).
+  /// `work` runs on the worker thread for each pushed item. push() waits while the queued items
+  /// weigh `capacity` (0: never; each weighs `weight(item)`, 1 when not given), so a worker slower
+  /// than the caller holds it back instead of queueing the whole input; an item is always taken
+  /// into an empty queue. With `background` false the work runs inside push() (no thread).
   explicit BackgroundWorker(std::function<void(Item&)> work, std::size_t capacity = 0,
-                            bool background = true)
-      : work_(std::move(work)), capacity_(capacity), background_(background) {
+                            bool background = true,
+                            std::function<std::size_t(const Item&)> weight = {})
+      : work_(std::move(work)),
+        weight_(std::move(weight)),
+        capacity_(capacity),
+        background_(background) {
     if (background_) thread_ = std::thread([this] { run(); });
   }
   /// Drops what is still queued and joins (an exception is unwinding the caller).
@@ -32,6 +37,7 @@ class BackgroundWorker {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       queue_.clear();
+      queued_weight_ = 0;
       closing_ = true;
     }
     ready_.notify_all();
@@ -47,12 +53,16 @@ class BackgroundWorker {
       work_(item);
       return;
     }
+    const std::size_t weight = weight_ ? weight_(item) : 1;
     const Stopwatch waiting;
     std::unique_lock<std::mutex> lock(mutex_);
-    space_.wait(lock, [&] { return error_ || capacity_ == 0 || queue_.size() < capacity_; });
+    space_.wait(lock, [&] {
+      return error_ || capacity_ == 0 || queue_.empty() || queued_weight_ + weight <= capacity_;
+    });
     waited_ms_ += waiting.ms();
     if (error_) std::rethrow_exception(error_);
-    queue_.push_back(std::move(item));
+    queued_weight_ += weight;
+    queue_.push_back({std::move(item), weight});
     lock.unlock();
     ready_.notify_one();
   }
@@ -84,7 +94,8 @@ class BackgroundWorker {
         std::unique_lock<std::mutex> lock(mutex_);
         ready_.wait(lock, [&] { return closing_ || !queue_.empty(); });
         if (queue_.empty()) return;  // closing and drained
-        item = std::move(queue_.front());
+        item = std::move(queue_.front().item);
+        queued_weight_ -= queue_.front().weight;
         queue_.pop_front();
       }
       space_.notify_one();
@@ -94,18 +105,26 @@ class BackgroundWorker {
         std::lock_guard<std::mutex> lock(mutex_);
         error_ = std::current_exception();
         queue_.clear();
+        queued_weight_ = 0;
         space_.notify_all();
         return;
       }
     }
   }
 
+  struct Queued {
+    Item item;
+    std::size_t weight;
+  };
+
   std::function<void(Item&)> work_;
+  std::function<std::size_t(const Item&)> weight_;
   std::size_t capacity_;
   bool background_;
   std::mutex mutex_;
   std::condition_variable ready_, space_;
-  std::deque<Item> queue_;
+  std::deque<Queued> queue_;
+  std::size_t queued_weight_ = 0;
   bool closing_ = false;
   std::exception_ptr error_;
   double waited_ms_ = 0.0;

@@ -25,7 +25,8 @@ struct LoopClosureRecord {
 
 /// A LoopClosure2D or LoopClosure3D fed through a queue: `add(loop_closure, input)` runs for each
 /// pushed input, on the worker thread with `own_thread`, else inside push(). push() waits while
-/// `queue` inputs are queued. The loop closure is the worker's until finish().
+/// the queued inputs weigh `queue` (each `weight(input)`, 1 when not given). The loop closure is
+/// the worker's until finish().
 template <typename LoopClosure, typename Input>
 class LoopClosureRun {
  public:
@@ -33,10 +34,12 @@ class LoopClosureRun {
 
   template <typename Options>
   LoopClosureRun(const Options& options, bool own_thread, std::size_t queue,
-                 std::function<void(LoopClosure&, Input&)> add)
+                 std::function<void(LoopClosure&, Input&)> add,
+                 std::function<std::size_t(const Input&)> weight = {})
       : loop_closure_(options),
         add_(std::move(add)),
-        worker_([this](Input& in) { add_(loop_closure_, in); }, queue, own_thread),
+        worker_([this](Input& in) { add_(loop_closure_, in); }, queue, own_thread,
+                std::move(weight)),
         thread_(own_thread) {}
 
   void push(Input input) { worker_.push(std::move(input)); }
