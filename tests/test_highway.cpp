@@ -16,6 +16,7 @@
 #include "scanmatch/sim/open_sequence.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
+#include "untimed_sequence.hpp"
 
 using namespace scanmatch;
 using namespace scanmatch::sim;
@@ -131,28 +132,11 @@ TEST(HighwayHdl64, EverySweepIsSmearedByTheCarsMotion) {
 
 namespace {
 
-// A simulated sequence whose frames lose their point times, as KITTI's raw scans come.
-class Untimed : public SequenceSource {
- public:
-  explicit Untimed(std::unique_ptr<SequenceSource> inner) : inner_(std::move(inner)) {}
-  std::size_t size() const override { return inner_->size(); }
-  bool next(Frame& frame) override {
-    if (!inner_->next(frame)) return false;
-    frame.cloud.time.clear();
-    return true;
-  }
-  std::optional<Trajectory> ground_truth() const override { return inner_->ground_truth(); }
-  std::string describe() const override { return "untimed " + inner_->describe(); }
-
- private:
-  std::unique_ptr<SequenceSource> inner_;
-};
-
 RunSummary ctf_icp_on_highway(std::size_t frames, bool timed, const OdometryConfig& config) {
   SequenceOptions input;
   input.simulator = highway(frames);
   std::unique_ptr<SequenceSource> source = open_sequence("sim:highway-hdl64", input);
-  if (!timed) source = std::make_unique<Untimed>(std::move(source));
+  if (!timed) source = std::make_unique<scanmatch::testing::UntimedSequence>(std::move(source));
   RunOptions options;
   options.quiet = true;  // no out_dir: nothing written
   return run_odometry(*source, config, options);

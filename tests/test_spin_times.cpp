@@ -14,6 +14,7 @@
 #include "scanmatch/sim/open_sequence.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "test_helpers.hpp"
+#include "untimed_sequence.hpp"
 
 using namespace scanmatch;
 using scanmatch::testing::sanitized;
@@ -42,29 +43,12 @@ double share_within(const PointCloud& truth, const PointCloud& derived, double t
   return static_cast<double>(close) / static_cast<double>(truth.size());
 }
 
-// A simulated sequence whose frames lose their point times, as KITTI's .bin scans have none.
-class Untimed : public SequenceSource {
- public:
-  explicit Untimed(std::unique_ptr<SequenceSource> inner) : inner_(std::move(inner)) {}
-  std::size_t size() const override { return inner_->size(); }
-  bool next(Frame& frame) override {
-    if (!inner_->next(frame)) return false;
-    frame.cloud.time.clear();
-    return true;
-  }
-  std::optional<Trajectory> ground_truth() const override { return inner_->ground_truth(); }
-  std::string describe() const override { return "untimed " + inner_->describe(); }
-
- private:
-  std::unique_ptr<SequenceSource> inner_;
-};
-
 std::unique_ptr<SequenceSource> simulated(std::size_t frames, bool timed) {
   SequenceOptions input;
   input.simulator = urban_hdl64(frames);
   auto source = open_sequence("sim:urban-hdl64", input);
   if (timed) return source;
-  return std::make_unique<Untimed>(std::move(source));
+  return std::make_unique<scanmatch::testing::UntimedSequence>(std::move(source));
 }
 
 RunSummary run(SequenceSource& source, const OdometryConfig& config) {
