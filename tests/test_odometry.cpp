@@ -444,6 +444,13 @@ TEST(Odometry, NewConfigurationFieldsAreValidatedByName) {
             std::string::npos);
   EXPECT_NE(error_for([](OdometryConfig& c) { c.max_step_ratio = 0.5; }).find("max_step_ratio"),
             std::string::npos);
+  // The gate spans a time gap in pieces of max_jump: 0 or NaN would divide the prior by nothing.
+  EXPECT_NE(error_for([](OdometryConfig& c) { c.max_jump = 0.0; }).find("max_jump"),
+            std::string::npos);
+  EXPECT_NE(error_for([](OdometryConfig& c) {
+              c.max_jump_angle = std::numeric_limits<double>::quiet_NaN();
+            }).find("max_jump_angle"),
+            std::string::npos);
   EXPECT_NE(
       error_for([](OdometryConfig& c) { c.uncertain_ndt_scale = 0.5; }).find("uncertain_ndt_scale"),
       std::string::npos);

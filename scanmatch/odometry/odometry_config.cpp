@@ -24,6 +24,8 @@ void check_odometry_config(const OdometryConfig& c) {
       throw Error(std::string("odometry: ") + name + " must be positive");
   };
   positive(c.ndt_resolution, "ndt_resolution");
+  positive(c.max_jump, "max_jump");
+  positive(c.max_jump_angle, "max_jump_angle");
   positive(c.map_voxel_size, "map_voxel_size");
   positive(c.map_radius, "map_radius");
   positive(c.max_range, "max_range");

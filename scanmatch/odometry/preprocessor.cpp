@@ -135,13 +135,15 @@ PointCloud Preprocessor::process(const PointCloud& frame, const FrameMotion* mot
   if (map_points != nullptr) map_points->clear();
   const PointCloud kept = crop_and_deskew(frame, motion);
   if (map_points != nullptr && sparse_frame(frame.size(), options_))
-    *map_points =
-        options_.voxel_size > 0.0 ? voxel_downsample(kept, 0.25 * options_.voxel_size) : kept;
+    *map_points = at_map_density(kept);
   return adaptive_downsample(kept, frame.size(), options_, &dense_voxel_);
 }
 
 PointCloud Preprocessor::map_detail(const PointCloud& frame, const FrameMotion* motion) const {
-  PointCloud kept = crop_and_deskew(frame, motion);
+  return at_map_density(crop_and_deskew(frame, motion));
+}
+
+PointCloud Preprocessor::at_map_density(const PointCloud& kept) const {
   return options_.voxel_size > 0.0 ? voxel_downsample(kept, 0.25 * options_.voxel_size) : kept;
 }
 

@@ -61,6 +61,8 @@ class Preprocessor {
 
  private:
   PointCloud crop_and_deskew(const PointCloud& frame, const FrameMotion* motion) const;
+  /// Cropped and deskewed points filtered at voxel_size / 4.
+  PointCloud at_map_density(const PointCloud& kept) const;
 
   PreprocessOptions options_;
   DenseVoxelMemory dense_voxel_;

@@ -1,16 +1,14 @@
 #include "scanmatch/registration/solver.hpp"
 
-#include "scanmatch/core/parallel.hpp"
-
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/core/parallel.hpp"
 
 namespace scanmatch {
 
