@@ -318,16 +318,17 @@ struct SearchSpace {
   /// the same floats in the same order as score() does, so the scores are the same to the bit.
   template <int Side, int Count = kBranch>
   void child_scores(int angle, int level, int x, int y, ChildScores& out) const;
-  /// The bounds of a level-2 block's children (level 1, corners 4 cells apart) and of a top
-  /// block's (level 2, 16 apart), as score() gives them, from their codes summed four at once.
-  void level1_bounds(int angle, int x, int y, ChildScores& out) const;
-  void level2_bounds(int angle, int x, int y, ChildScores& out) const;
+  /// The bounds of the kBranch x kBranch children at `Level` (1: a level-2 block's, corners 4
+  /// cells apart; 2: a top block's, 16 apart), as score() gives them, from their codes summed as
+  /// integers (level 1's four a row at once with SSE2).
+  template <int Level>
+  void child_bounds(int angle, int x, int y, ChildScores& out) const;
   /// The scores (level 1: of the poses) or bounds of the children of the block at `level` (1 to
   /// kLevels - 1) with its corner at (x, y), row by row.
   void children(int angle, int level, int x, int y, ChildScores& out) const {
     if (level == 1) return child_scores<1>(angle, 0, x, y, out);
-    if (level == 2) return level1_bounds(angle, x, y, out);
-    level2_bounds(angle, x, y, out);
+    if (level == 2) return child_bounds<1>(angle, x, y, out);
+    child_bounds<2>(angle, x, y, out);
   }
   Pose2 pose(int angle, int x, int y) const {
     const Pose2& initial = scan->initial();
@@ -382,10 +383,17 @@ struct RowSums {
 };
 #endif
 
-void SearchSpace::level1_bounds(int angle, int x, int y, ChildScores& out) const {
-  constexpr int kSide = kSides[1], kReach = (kBranch - 1) * kSide;
+template <int Level>
+void SearchSpace::child_bounds(int angle, int x, int y, ChildScores& out) const {
+  constexpr int kSide = kSides[Level], kReach = (kBranch - 1) * kSide;
+  // One 16-byte load reads a row's four children where they lie 4 bytes apart (level 1).
+#if defined(__SSE2__)
+  constexpr bool kVector = kSide == 4;
+#else
+  constexpr bool kVector = false;
+#endif
   const LikelihoodGrid& g = grid();
-  const Code* data = g.level(1);
+  const Code* data = g.level(Level);
   const int width = g.width, height = g.height;
   const std::size_t row_step = static_cast<std::size_t>(kSide) * static_cast<std::size_t>(width);
   const int shift_x = x - half_x, shift_y = y - half_y;
@@ -400,48 +408,28 @@ void SearchSpace::level1_bounds(int angle, int x, int y, ChildScores& out) const
       const Code* row = data + static_cast<std::size_t>(gy) * static_cast<std::size_t>(width) +
                         static_cast<std::size_t>(gx);
       for (int dy = 0; dy < kBranch; ++dy, row += row_step) {
+        if constexpr (kVector) {
 #if defined(__SSE2__)
-        // 16 bytes from the first child's cell: each 32-bit lane's low byte is a child's.
-        rows.add(dy,
-                 _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row)), low_bytes));
-#else
-        for (int dx = 0; dx < kBranch; ++dx) sum[dy * kBranch + dx] += row[dx * kSide];
+          // 16 bytes from the first child's cell: each 32-bit lane's low byte is a child's.
+          rows.add(
+              dy, _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row)), low_bytes));
 #endif
+        } else {
+          for (int dx = 0; dx < kBranch; ++dx) sum[dy * kBranch + dx] += row[dx * kSide];
+        }
       }
     } else if (gx + kReach >= 0 && gy + kReach >= 0 && gx < width && gy < height) {
       for (int dy = 0; dy < kBranch; ++dy)
         for (int dx = 0; dx < kBranch; ++dx)
-          sum[dy * kBranch + dx] += g.code(1, gx + dx * kSide, gy + dy * kSide);
+          sum[dy * kBranch + dx] += g.code(Level, gx + dx * kSide, gy + dy * kSide);
     }
   }
 #if defined(__SSE2__)
-  const std::array<std::uint32_t, 16> lanes = rows.sums();
-  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += lanes[i];
-#endif
-  for (std::size_t i = 0; i < sum.size(); ++i) out[i] = bound(sum[i]);
-}
-
-void SearchSpace::level2_bounds(int angle, int x, int y, ChildScores& out) const {
-  constexpr int kSide = kSides[2], kReach = (kBranch - 1) * kSide;
-  const LikelihoodGrid& g = grid();
-  const Code* data = g.level(2);
-  const int width = g.width, height = g.height;
-  const std::size_t row_step = static_cast<std::size_t>(kSide) * static_cast<std::size_t>(width);
-  const int shift_x = x - half_x, shift_y = y - half_y;
-  std::array<std::uint32_t, 16> sum{};
-  for (const auto& [cx, cy] : scan->cells(angle)) {
-    const int gx = cx + shift_x, gy = cy + shift_y;
-    if (gx >= 0 && gy >= 0 && gx + kReach < width && gy + kReach < height) {
-      const Code* row = data + static_cast<std::size_t>(gy) * static_cast<std::size_t>(width) +
-                        static_cast<std::size_t>(gx);
-      for (int dy = 0; dy < kBranch; ++dy, row += row_step)
-        for (int dx = 0; dx < kBranch; ++dx) sum[dy * kBranch + dx] += row[dx * kSide];
-    } else if (gx + kReach >= 0 && gy + kReach >= 0 && gx < width && gy < height) {
-      for (int dy = 0; dy < kBranch; ++dy)
-        for (int dx = 0; dx < kBranch; ++dx)
-          sum[dy * kBranch + dx] += g.code(2, gx + dx * kSide, gy + dy * kSide);
-    }
+  if constexpr (kVector) {
+    const std::array<std::uint32_t, 16> lanes = rows.sums();
+    for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += lanes[i];
   }
+#endif
   for (std::size_t i = 0; i < sum.size(); ++i) out[i] = bound(sum[i]);
 }
 
@@ -838,7 +826,7 @@ CorrelativeSpread spread_in(const SearchSpace& space, const Pose2& at, double ma
   for (int a = -space.angles; a <= space.angles; ++a) {
     for (int y = 0; y < space.span_y; y += kBranch * kSide)
       for (int x = 0; x < space.span_x; x += kBranch * kSide) {
-        space.level1_bounds(a, x, y, children);
+        space.child_bounds<1>(a, x, y, children);
         for (int dy = 0; dy < kBranch && y + dy * kSide < space.span_y; ++dy)
           for (int dx = 0; dx < kBranch && x + dx * kSide < space.span_x; ++dx)
             bounds[static_cast<std::size_t>((y / kSide + dy) * columns + x / kSide + dx)] =
