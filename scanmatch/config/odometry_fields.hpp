@@ -98,6 +98,13 @@ void describe(OdometryConfig& c, Visitor& v) {
     "then solved on every point");
   v("uncertain_jump_scale", c.uncertain_jump_scale, nullptr,
     "max_jump and max_jump_angle widen by this factor under an uncertain prior");
+  v("global_start_below", c.global_start_below, nullptr,
+    "ctf-icp, uncertain prior: where less than this share of the frame lies within 0.5 m of the "
+    "last frame, it is also registered onto the last frame with no prior (FPFH features), kept "
+    "where global_start_gain times as much of it overlaps (0: off)");
+  v("global_start_gain", c.global_start_gain, nullptr,
+    "ctf-icp: how many times more of the frame the global start's result must overlap the last "
+    "frame with to replace the first");
   v("min_downsampled_points", c.min_downsampled_points, nullptr,
     "sparse frames (below 10x this) keeping fewer points get smaller voxels, to voxel_size / 4 "
     "(0: off)");

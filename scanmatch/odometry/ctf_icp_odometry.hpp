@@ -35,6 +35,13 @@ class CtfIcpOdometry final : public OdometryPipeline {
  private:
   Pose estimate(const PointCloud& frame, const MotionPrior& prior, const Pose& predicted,
                 FrameStats& stats) override;
+  /// Under an uncertain prior, where little of the frame overlaps the last one at `estimate`:
+  /// the frame registered onto the last one with no prior and refined against `target` from
+  /// there; `estimate` unless that overlaps the last frame clearly more.
+  Pose global_start(const PointCloud& frame, const GaussianVoxelMap& target, bool young_map,
+                    const Pose& estimate, FrameStats& stats);
+  /// Share of the frame's points within the global stage's feature voxel of the last frame.
+  double overlap_with_last(const PointCloud& frame, const Pose& pose) const;
   void update_reference(PointCloud frame, const PointCloud& map_points, const Pose& pose,
                         bool bridged, FrameStats& stats) override;
   void restart_reference(PointCloud first, const PointCloud& map_points) override;

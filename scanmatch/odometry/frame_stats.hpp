@@ -28,6 +28,7 @@ struct FrameStats {
   // Health of the frame: how far to trust it.
   bool prior_uncertain = false;
   bool recovered = false;
+  bool global_start = false;
   bool redeskewed = false;
   double prior_miss_m = 0, prior_miss_deg = 0;
   double fine_paired_fraction = 0;
@@ -58,6 +59,9 @@ void describe(Stats& s, Visitor& v) {
   v("recovered", s.recovered,
     "ctf-icp: another coarse start (the identity, a scaled or a turned prior) scored better than "
     "the prior's own result, and replaced it");
+  v("global_start", s.global_start,
+    "ctf-icp: under an uncertain prior little of the frame overlapped the last one, and its pose "
+    "came from a registration onto the last frame with no prior (global_start_below)");
   v("redeskewed", s.redeskewed,
     "the registered motion missed the prior the frame was deskewed by (redeskew_translation, "
     "redeskew_rotation): deskewed again by it and registered again");

@@ -44,6 +44,11 @@ void check_odometry_config(const OdometryConfig& c) {
         "pi) and rotation_starts within 0..18");
   if (!(c.uncertain_ndt_scale >= 1.0) || !(c.uncertain_jump_scale >= 1.0))
     throw Error("odometry: uncertain_ndt_scale and uncertain_jump_scale must be at least 1");
+  if (!(c.global_start_below >= 0.0 && c.global_start_below <= 1.0) ||
+      !(c.global_start_gain >= 1.0))
+    throw Error(
+        "odometry: global_start_below must lie within 0..1 (0: off) and global_start_gain be at "
+        "least 1");
   if (c.wide_start_iterations < 0)
     throw Error("odometry: wide_start_iterations must not be negative (0: never)");
   positive(c.prior_miss_distance, "prior_miss_distance");

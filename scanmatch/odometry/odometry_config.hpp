@@ -134,6 +134,16 @@ struct OdometryConfig {
   /// ... and only this many best-ranked starts are then solved on every point.
   int start_full_solves = 1;
   double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
+  /// ctf-icp, uncertain prior, a thin map (health.hpp): where less than this share of the
+  /// frame's points lies within 0.5 m (the global stage's feature voxel) of the last frame's, the
+  /// frame is also registered onto the last one with no prior
+  /// (registration/global_registration.hpp: FPFH features and a maximum consistent set) and refined
+  /// against the map from there; that result replaces the first, beyond the motion gate if need be,
+  /// where global_start_gain times as many points overlap. Keyframes metres apart at irregular
+  /// times leave a constant-velocity prior metres off, outside every local basin; consecutive
+  /// frames overlap 0.8-0.9 (0: off).
+  double global_start_below = 0.5;
+  double global_start_gain = 1.3;
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel
   /// filter are downsampled with smaller voxels (down to voxel_size / 4; 0: off).
   std::uint32_t min_downsampled_points = 1000;

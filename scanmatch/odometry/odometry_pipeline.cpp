@@ -75,7 +75,10 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   if (frames_ > 0) first_frame_ = PointCloud{};
   // Never let a failed solve poison the trajectory: a result far from the motion prior (or not
   // finite) is replaced by the prior.
-  if (!motion_.within_gate(predicted, estimate)) {
+  // A global start's result is verified by its own evidence (more of the frame paired), not by
+  // a prior that it was called in because that prior could not be trusted.
+  const bool verified = stats_.global_start && estimate.matrix().allFinite();
+  if (!verified && !motion_.within_gate(predicted, estimate)) {
     stats_.bridged = true;
     estimate = predicted;
   }

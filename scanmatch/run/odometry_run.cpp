@@ -77,11 +77,12 @@ nlohmann::ordered_json stages_json(const std::vector<StageStatistics>& stages) {
 
 // How far the run can be trusted, from its frames' health records (frame_stats.hpp).
 nlohmann::ordered_json health_json(const std::vector<FrameStats>& frames) {
-  std::size_t uncertain = 0, recovered = 0, thin = 0, disagreeing = 0;
+  std::size_t uncertain = 0, recovered = 0, global_starts = 0, thin = 0, disagreeing = 0;
   std::vector<double> paired;
   for (const FrameStats& f : frames) {
     uncertain += f.prior_uncertain;
     recovered += f.recovered;
+    global_starts += f.global_start;
     disagreeing += health::stages_disagree(f);
     thin += health::thin_map(f);
     if (f.fine_paired_fraction > 0.0) paired.push_back(f.fine_paired_fraction);
@@ -89,6 +90,7 @@ nlohmann::ordered_json health_json(const std::vector<FrameStats>& frames) {
   std::sort(paired.begin(), paired.end());
   return {{"uncertain_priors", uncertain},
           {"recoveries", recovered},
+          {"global_starts", global_starts},
           {"thin_map_frames", thin},
           {"coarse_fine_disagreements", disagreeing},
           {"median_fine_paired_fraction", paired.empty() ? 0.0 : paired[paired.size() / 2]}};
