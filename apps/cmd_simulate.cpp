@@ -38,6 +38,10 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_flag("--no-motion-distortion", *no_distortion,
                 "Measure every point of a frame from the frame's start pose");
   cmd->add_flag("--no-noise", *no_noise, "No range noise and no dropouts");
+  cmd->add_option("--elevation-bias", options->elevation_bias_deg,
+                  "3D sensors: points reported this many degrees higher in elevation than the "
+                  "beams that measured them (a calibration error; odometry's "
+                  "--elevation-correction takes it out)");
   cmd->add_option("--every", keyframes->every, "Keyframes: keep every Nth frame");
   cmd->add_option("--keyframe-distance", keyframes->distance,
                   "Keyframes: keep a frame once the sensor moved this many m since the last kept");

@@ -11,6 +11,8 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("voxel_size", c.voxel_size, "--voxel", "Downsampling voxel of every frame, m (0: none)");
   v("min_range", c.min_range, "--min-range", "Nearer points are dropped, m");
   v("max_range", c.max_range, "--max-range", "Farther points are dropped, m");
+  v("elevation_correction_deg", c.elevation_correction_deg, "--elevation-correction",
+    "Lower every point's elevation by this many degrees first (a beam calibration error)");
   v("ndt_resolution", c.ndt_resolution, "--ndt-resolution",
     "ctf-icp: the coarse stage's NDT grid of the previous frame, m");
   v("ndt_neighbours", c.ndt_neighbours, nullptr, "ctf-icp coarse: voxels per point");
@@ -99,9 +101,9 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("uncertain_jump_scale", c.uncertain_jump_scale, nullptr,
     "max_jump and max_jump_angle widen by this factor under an uncertain prior");
   v("global_start_below", c.global_start_below, nullptr,
-    "ctf-icp, uncertain prior: where less than this share of the frame lies within 0.5 m of the "
-    "last frame, it is also registered onto the last frame with no prior (FPFH features), kept "
-    "where global_start_gain times as much of it overlaps (0: off)");
+    "ctf-icp, the first motion: where less than this share of the frame lies within 0.5 m of the "
+    "first frame, it is also registered onto it with no prior (FPFH features), kept where "
+    "global_start_gain times as much of it overlaps (0: off)");
   v("global_start_gain", c.global_start_gain, nullptr,
     "ctf-icp: how many times more of the frame the global start's result must overlap the last "
     "frame with to replace the first");

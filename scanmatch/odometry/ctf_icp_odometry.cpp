@@ -63,9 +63,11 @@ Pose CtfIcpOdometry::estimate(const PointCloud& frame, const MotionPrior& prior,
     stats.iterations += fine.iterations;
     stats.condition_number = fine.condition_number;
     stats.fine_ms = fine_time.ms();
-    // Where the map held the frame well, it overlaps the last frame too (checked by the thin-map
-    // health rule first: the overlap costs a k-d tree of the last frame, 0.8 ms on avia_hku1).
-    if (prior.uncertain && config().global_start_below > 0.0 &&
+    // Only the first motion, whose prior is no information at all: later priors carry a measured
+    // motion, and a long true step overlaps the last frame less than an overlay near standing
+    // still does (docs/odometry.md, "Global start"). Where the map held the frame well it
+    // overlaps the last frame too (the thin-map health rule first: the overlap costs a k-d tree).
+    if (frames() == 1 && config().global_start_below > 0.0 &&
         stats.fine_paired_fraction < health::kThinPairedFraction)
       estimate = global_start(frame, target, young_map, estimate, stats);
   }

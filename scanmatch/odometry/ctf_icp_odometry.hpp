@@ -35,7 +35,7 @@ class CtfIcpOdometry final : public OdometryPipeline {
  private:
   Pose estimate(const PointCloud& frame, const MotionPrior& prior, const Pose& predicted,
                 FrameStats& stats) override;
-  /// Under an uncertain prior, where little of the frame overlaps the last one at `estimate`:
+  /// The first motion, where little of the frame overlaps the last one at `estimate`:
   /// the frame registered onto the last one with no prior and refined against `target` from
   /// there; `estimate` unless that overlaps the last frame clearly more.
   Pose global_start(const PointCloud& frame, const GaussianVoxelMap& target, bool young_map,

@@ -60,8 +60,8 @@ void describe(Stats& s, Visitor& v) {
     "ctf-icp: another coarse start (the identity, a scaled or a turned prior) scored better than "
     "the prior's own result, and replaced it");
   v("global_start", s.global_start,
-    "ctf-icp: under an uncertain prior little of the frame overlapped the last one, and its pose "
-    "came from a registration onto the last frame with no prior (global_start_below)");
+    "ctf-icp: the first motion left little of the frame overlapping the first one, and its pose "
+    "came from a registration onto it with no prior (global_start_below)");
   v("redeskewed", s.redeskewed,
     "the registered motion missed the prior the frame was deskewed by (redeskew_translation, "
     "redeskew_rotation): deskewed again by it and registered again");

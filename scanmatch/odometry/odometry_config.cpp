@@ -51,6 +51,8 @@ void check_odometry_config(const OdometryConfig& c) {
         "least 1");
   if (c.wide_start_iterations < 0)
     throw Error("odometry: wide_start_iterations must not be negative (0: never)");
+  if (!(std::abs(c.elevation_correction_deg) <= 5.0))
+    throw Error("odometry: elevation_correction_deg must lie within -5..5 degrees");
   positive(c.prior_miss_distance, "prior_miss_distance");
   if (c.degeneracy_guard_frames < 0 || !(c.degeneracy_guard_ratio >= 0.0) ||
       !(c.degeneracy_ratio >= 0.0))

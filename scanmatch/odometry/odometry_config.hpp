@@ -15,6 +15,10 @@ struct OdometryConfig {
   double voxel_size = 0.25;        ///< m, downsampling of every frame (0: none)
   double min_range = 0.3;          ///< m: nearer points (the robot itself) are dropped
   double max_range = 100.0;        ///< m: farther points are dropped
+  /// deg: every point's elevation is lowered by this before anything else, for a sensor whose
+  /// beams point lower than its points say (geometry/beam_elevation.hpp; docs/odometry.md,
+  /// "riverside02_keyframes: what is left"). 0: as delivered.
+  double elevation_correction_deg = 0.0;
   // Coarse stage (ctf-icp): NDT against the previous frame.
   double ndt_resolution = 1.0;     ///< m, the NDT grid of the previous frame
   int ndt_neighbours = 1;          ///< voxels per point: 1, 7 or 27
@@ -134,14 +138,15 @@ struct OdometryConfig {
   /// ... and only this many best-ranked starts are then solved on every point.
   int start_full_solves = 1;
   double uncertain_jump_scale = 3.0;  ///< max_jump and max_jump_angle widen by this factor
-  /// ctf-icp, uncertain prior, a thin map (health.hpp): where less than this share of the
-  /// frame's points lies within 0.5 m (the global stage's feature voxel) of the last frame's, the
-  /// frame is also registered onto the last one with no prior
+  /// ctf-icp, the first motion (no prior at all), a thin map (health.hpp): where less than this
+  /// share of the frame's points lies within 0.5 m (the global stage's feature voxel) of the first
+  /// frame's, the frame is also registered onto it with no prior
   /// (registration/global_registration.hpp: FPFH features and a maximum consistent set) and refined
   /// against the map from there; that result replaces the first, beyond the motion gate if need be,
-  /// where global_start_gain times as many points overlap. Keyframes metres apart at irregular
-  /// times leave a constant-velocity prior metres off, outside every local basin; consecutive
-  /// frames overlap 0.8-0.9 (0: off).
+  /// where global_start_gain times as many points overlap. A keyframe folder may start metres from
+  /// where the identity guess puts it; consecutive frames overlap 0.8-0.9 (0: off). Not for later
+  /// frames: a long true step overlaps the last frame less than an overlay near standing still
+  /// (docs/odometry.md).
   double global_start_below = 0.5;
   double global_start_gain = 1.3;
   /// Sparse frames (fewer than 10 times this many points) keeping fewer points after the voxel

@@ -5,6 +5,7 @@
 #include <optional>
 #include <utility>
 
+#include "scanmatch/geometry/beam_elevation.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 
 namespace scanmatch {
@@ -88,6 +89,7 @@ PreprocessOptions preprocess_options(const OdometryConfig& config, bool keep_att
   o.min_range = config.min_range;
   o.max_range = config.max_range;
   o.voxel_size = config.voxel_size;
+  o.elevation_correction = config.elevation_correction_deg * M_PI / 180.0;
   o.min_downsampled_points = config.min_downsampled_points;
   o.max_downsampled_points = config.max_downsampled_points;
   o.keep_attributes = keep_attributes;
@@ -114,10 +116,12 @@ PointCloud Preprocessor::crop_and_deskew(const PointCloud& frame, const FrameMot
   if (deskew) deskewing.emplace(*motion, latest_point_time(frame), 0.5 * motion->period);
   const bool keep_ring = frame.has_ring() && options_.keep_attributes;
   const bool keep_intensity = frame.has_intensity() && options_.keep_attributes;
+  const bool corrected = options_.elevation_correction != 0.0;
+  const ElevationTurn correction(-options_.elevation_correction);
   PointCloud kept;
   kept.points.reserve(frame.size());
   for (std::size_t i = 0; i < frame.size(); ++i) {
-    const Point& p = frame.points[i];
+    const Point p = corrected ? correction(frame.points[i]) : frame.points[i];
     const double r2 = p.squaredNorm();
     if (!p.allFinite() || r2 < min2 || r2 > max2) continue;
     if (deskew && std::isfinite(frame.time[i]))

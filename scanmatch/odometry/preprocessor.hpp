@@ -29,6 +29,7 @@ struct FrameMotion {
 struct PreprocessOptions {
   double min_range = 0.3, max_range = 100.0;    ///< m
   double voxel_size = 0.25;                     ///< m (0: no filter)
+  double elevation_correction = 0.0;            ///< rad: every point's elevation lowered by this
   std::uint32_t min_downsampled_points = 1000;  ///< point floor of sparse frames (0: off)
   std::uint32_t max_downsampled_points = 0;     ///< point ceiling of every frame (0: off)
   /// Keep rings and intensities (feature methods read them); otherwise only positions are kept.

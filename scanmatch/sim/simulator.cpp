@@ -8,6 +8,7 @@
 
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/progress.hpp"
+#include "scanmatch/geometry/beam_elevation.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/io/file_util.hpp"
 #include "scanmatch/sim/random.hpp"
@@ -98,6 +99,8 @@ Simulator::Simulator(const SimOptions& options)
                 "' (2D sensors go with 2D presets)");
   frames_ = options.frames.value_or(preset_->frames);
   if (frames_ == 0) throw Error("simulator: --frames must be at least 1");
+  if (!(std::abs(options.elevation_bias_deg) <= 5.0))
+    throw Error("simulator: --elevation-bias must lie within -5..5 degrees");
   const double period = sensor_->frame_period();
   // The motion spans the preset's full length so that truncated runs are prefixes of full ones.
   const double duration = static_cast<double>(std::max(frames_, preset_->frames)) * period + period;
@@ -172,6 +175,8 @@ PointCloud Simulator::frame(std::size_t i) const {
   const double t0 = frame_time(i);
   const SensorModel& s = *sensor_;
   const Pose frame_pose = motion_.at(t0);
+  const bool biased = options_.elevation_bias_deg != 0.0 && !s.is_2d();
+  const ElevationTurn beam_from_reported(-options_.elevation_bias_deg * M_PI / 180.0);
   // Each ray is independent (its own pose and random numbers), so the parallel loop gives the
   // same result as a serial one.
   tbb::parallel_for(
@@ -179,7 +184,8 @@ PointCloud Simulator::frame(std::size_t i) const {
         for (std::size_t k = r.begin(); k < r.end(); ++k) {
           const Pose T =
               options_.motion_distortion ? motion_.at(t0 + pattern.times[k]) : frame_pose;
-          const Eigen::Vector3d dir = T.linear() * pattern.directions[k].cast<double>();
+          const Eigen::Vector3d nominal = pattern.directions[k].cast<double>();
+          const Eigen::Vector3d dir = T.linear() * (biased ? beam_from_reported(nominal) : nominal);
           const RayHit hit =
               world_.scene.raycast(T.translation(), dir, s.min_range,
                                    std::max(s.max_range, s.high_reflectivity_max_range));
@@ -296,6 +302,7 @@ void write_dataset(const Simulator& sim, const std::string& folder, bool quiet,
       {"path_length_m", selection.frames.empty() ? sim.path_length() : path},
       {"motion_distortion", sim.options().motion_distortion},
       {"noise", sim.options().noise},
+      {"elevation_bias_deg", sim.options().elevation_bias_deg},
       {"points", points},
       {"description", sim.preset().description}};
   if (selection.describe) selection.describe(info);

@@ -27,7 +27,10 @@ struct SimOptions {
   /// Each point measured from the pose at its own time; false: every point from the frame's start
   /// pose, and frames carry no per-point time.
   bool motion_distortion = true;
-  bool noise = true;            ///< range noise and dropouts
+  bool noise = true;  ///< range noise and dropouts
+  /// A beam calibration error of 3D sensors: every point is reported this much higher in
+  /// elevation (deg) than the beam that measured it (geometry/beam_elevation.hpp). 0: exact.
+  double elevation_bias_deg = 0.0;
   std::string trajectory_file;  ///< replay this KITTI/TUM trajectory instead of the preset's path
   /// Replay this trajectory (anchored like trajectory_file); wins over trajectory_file.
   std::optional<Trajectory> trajectory;
