@@ -105,8 +105,8 @@ void describe(OdometryConfig& c, Visitor& v) {
     "first frame, it is also registered onto it with no prior (FPFH features), kept where "
     "global_start_gain times as much of it overlaps (0: off)");
   v("global_start_gain", c.global_start_gain, nullptr,
-    "ctf-icp: how many times more of the frame the global start's result must overlap the last "
-    "frame with to replace the first");
+    "ctf-icp: how many times more of the frame the global start's result must overlap the first "
+    "frame with to replace the local result");
   v("min_downsampled_points", c.min_downsampled_points, nullptr,
     "sparse frames (below 10x this) keeping fewer points get smaller voxels, to voxel_size / 4 "
     "(0: off)");

@@ -75,8 +75,8 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   if (frames_ > 0) first_frame_ = PointCloud{};
   // Never let a failed solve poison the trajectory: a result far from the motion prior (or not
   // finite) is replaced by the prior.
-  // A global start's result is verified by its own evidence (more of the frame paired), not by
-  // a prior that it was called in because that prior could not be trusted.
+  // A global start's result is verified by its own evidence (more of the frame overlapping the
+  // first one), not by the first motion's prior, the identity, which says nothing.
   const bool verified = stats_.global_start && estimate.matrix().allFinite();
   if (!verified && !motion_.within_gate(predicted, estimate)) {
     stats_.bridged = true;
