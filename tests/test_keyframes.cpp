@@ -150,7 +150,7 @@ TEST(SimulatorKeyframes, TheCliWritesAKeyframeFolderThatOdometryTracksWithDefaul
   ASSERT_GT(frames, 40u);
   EXPECT_EQ(info["keyframes"]["frame_indices"].size(), frames);
   const std::size_t first = info["keyframes"]["frame_indices"][1];
-  char name[32];
+  char name[48];
   std::snprintf(name, sizeof name, "/frames/%06zu.pcd", first);
   const PointCloud cloud = read_cloud(data + name);
   EXPECT_EQ(cloud.size(), 4000u);
@@ -443,7 +443,7 @@ MissedTurn avia_missed_turn() {
   if (folder.empty()) return m;
   const std::size_t a = 12, b = 13;
   const auto frame_at = [&](std::size_t i) {
-    char name[32];
+    char name[48];
     std::snprintf(name, sizeof(name), "/frames/%06zu.pcd", i);
     return voxel_downsample(read_cloud(folder + name), 0.25);
   };
@@ -598,7 +598,7 @@ TEST(AdaptiveRules, AStartOutsideTheGateGivesWayToTheOptimumInside) {
   std::vector<Pose> poses;
   std::size_t bridged = 0;
   for (std::size_t i = 0; i < frames; ++i) {
-    char name[32];
+    char name[48];
     std::snprintf(name, sizeof(name), "/frames/%06zu.pcd", i);
     poses.push_back(odometry.register_frame(read_cloud(folder + name), times[i]));
     bridged += odometry.last_stats().bridged;
