@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 #include <sstream>
@@ -375,6 +376,71 @@ TEST(GridMap, SimulatedRoomGivesOccupiedCellsOnTheWalls) {
   // The grid holds the whole room (a margin included).
   EXPECT_GE(grid.width() * options.resolution, 4.0);
   EXPECT_GE(grid.height() * options.resolution, 3.0);
+}
+
+// insert_scan against a straightforward version of it: each beam's cells from a grid holding
+// that beam alone, their union per scan (hits winning), one clamped update per cell, in float.
+// Many beams of a scan cross near the sensor, scans overlap and repeat (the clamps), and the grid
+// grows and is cropped between them.
+TEST(GridMap, InsertScanMatchesOneUpdatePerCellOfTheBeamsUnion) {
+  const GridMapOptions options = with_resolution(0.1);
+  using Cell = std::pair<long, long>;
+  const auto cell_of = [&](const Eigen::Vector2d& world) {
+    return Cell(static_cast<long>(std::floor(world.x() / options.resolution)),
+                static_cast<long>(std::floor(world.y() / options.resolution)));
+  };
+  const auto centre = [&](const Cell& c) {
+    return Eigen::Vector2d((c.first + 0.5) * options.resolution,
+                           (c.second + 0.5) * options.resolution);
+  };
+  // One beam alone: its observed cells are the ray's, the occupied one its end.
+  const auto beam_cells = [&](const Eigen::Isometry2d& at, const Eigen::Vector2d& end, bool hit,
+                              std::set<Cell>& free, std::set<Cell>& hits) {
+    OccupancyGrid alone(options);
+    if (hit)
+      alone.insert_scan(at, {end});
+    else
+      alone.insert_scan(at, {}, {end});
+    for (int row = 0; row < alone.height(); ++row)
+      for (int column = 0; column < alone.width(); ++column) {
+        const Eigen::Vector2d c = alone.cell_centre(column, row);
+        if (!alone.observed(c)) continue;
+        (alone.occupied(c) ? hits : free).insert(cell_of(c));
+      }
+  };
+  std::map<Cell, float> expected;
+  OccupancyGrid grid(options);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int scan = 0; scan < 24; ++scan) {
+    // Back and forth between two places 6 m apart, so that later scans grow the grid.
+    const Eigen::Isometry2d at = pose(scan % 3 == 2 ? 6.0 + unit(random) : unit(random),
+                                      unit(random), 2 * M_PI * unit(random));
+    std::vector<Eigen::Vector2d> hits, misses;
+    for (int beam = 0; beam < 60; ++beam) {
+      const double angle = 2 * M_PI * beam / 60.0, range = 0.3 + 2.5 * unit(random);
+      (beam % 7 == 0 ? misses : hits)
+          .emplace_back(range * std::cos(angle), range * std::sin(angle));
+    }
+    grid.insert_scan(at, hits, misses);
+    std::set<Cell> free_cells, hit_cells;
+    for (const Eigen::Vector2d& h : hits) beam_cells(at, h, true, free_cells, hit_cells);
+    for (const Eigen::Vector2d& m : misses) beam_cells(at, m, false, free_cells, free_cells);
+    const auto update = [&](const Cell& c, double delta) {
+      const auto it = expected.find(c);
+      const double before = it == expected.end() ? 0.0 : it->second;
+      expected[c] = static_cast<float>(
+          std::clamp(before + delta, options.min_log_odds, options.max_log_odds));
+    };
+    for (const Cell& c : free_cells)
+      if (!hit_cells.count(c)) update(c, options.miss_log_odds);
+    for (const Cell& c : hit_cells) update(c, options.hit_log_odds);
+    if (scan == 10) grid.crop_to_observed();
+  }
+  EXPECT_EQ(observed_cell_count(grid), static_cast<int>(expected.size()));
+  for (const auto& [cell, log_odds] : expected)
+    ASSERT_EQ(grid.probability(centre(cell)), log_odds_to_probability(log_odds))
+        << "cell " << cell.first << ", " << cell.second;
 }
 
 TEST(GridMap, GrowingKeepsCellsAtTheirWorldPositions) {

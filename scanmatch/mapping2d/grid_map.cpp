@@ -126,39 +126,37 @@ void OccupancyGrid::insert_scan(const Eigen::Isometry2d& sensor_pose,
     return static_cast<std::int64_t>(cell.y() - origin_cell_.y()) * width_ +
            (cell.x() - origin_cell_.x());
   };
-  std::vector<std::int64_t> hit_cells;
-  std::vector<std::int64_t> free_cells;
-  hit_cells.reserve(hits.size());
-  const auto add_free = [&](const Eigen::Vector2i& cell) {
-    free_cells.push_back(storage_index(cell));
+  // One update per cell and scan, hits winning over misses: each cell a ray touches is marked
+  // (kFreeMark, then kHitMark over it) and listed once; the marks are cleared again at the end.
+  // Cheaper than sorting every ray's cells, and each cell gets the same single update.
+  constexpr std::uint8_t kUntouched = 0, kFreeMark = 1, kHitMark = 2;
+  if (scan_marks_.size() != log_odds_.size()) scan_marks_.assign(log_odds_.size(), kUntouched);
+  std::vector<std::int64_t> touched;
+  touched.reserve(8 * (hits.size() + misses.size()));
+  const auto mark = [&](const Eigen::Vector2i& cell, std::uint8_t kind) {
+    const std::int64_t index = storage_index(cell);
+    std::uint8_t& m = scan_marks_[static_cast<std::size_t>(index)];
+    if (m == kUntouched) touched.push_back(index);
+    m = std::max(m, kind);
   };
+  const auto add_free = [&](const Eigen::Vector2i& cell) { mark(cell, kFreeMark); };
   for (const Eigen::Vector2d& hit : hits) {
     for_each_cell_before_end(sensor, hit, add_free);
-    hit_cells.push_back(storage_index(floor_cell(hit)));
+    mark(floor_cell(hit), kHitMark);
   }
   for (const Eigen::Vector2d& miss : misses) {
     for_each_cell_before_end(sensor, miss, add_free);
     add_free(floor_cell(miss));
   }
-
-  // One update per cell and scan; hits win over misses.
-  std::sort(hit_cells.begin(), hit_cells.end());
-  hit_cells.erase(std::unique(hit_cells.begin(), hit_cells.end()), hit_cells.end());
-  std::sort(free_cells.begin(), free_cells.end());
-  free_cells.erase(std::unique(free_cells.begin(), free_cells.end()), free_cells.end());
-  const auto update = [&](std::int64_t index, double delta) {
+  for (const std::int64_t index : touched) {
+    std::uint8_t& m = scan_marks_[static_cast<std::size_t>(index)];
     float& cell = log_odds_[static_cast<std::size_t>(index)];
     const double before = std::isnan(cell) ? 0.0 : cell;
+    const double delta = m == kHitMark ? options_.hit_log_odds : options_.miss_log_odds;
     cell = static_cast<float>(
         std::clamp(before + delta, options_.min_log_odds, options_.max_log_odds));
-  };
-  auto hit_it = hit_cells.begin();
-  for (std::int64_t index : free_cells) {
-    while (hit_it != hit_cells.end() && *hit_it < index) ++hit_it;
-    if (hit_it != hit_cells.end() && *hit_it == index) continue;
-    update(index, options_.miss_log_odds);
+    m = kUntouched;
   }
-  for (std::int64_t index : hit_cells) update(index, options_.hit_log_odds);
 }
 
 void OccupancyGrid::ensure_contains(const Eigen::Vector2i& low, const Eigen::Vector2i& high) {

@@ -131,6 +131,8 @@ class OccupancyGrid {
   int width_ = 0;
   int height_ = 0;
   std::vector<float> log_odds_;  // row-major from the lowest y; NaN marks a cell never observed
+  // insert_scan's per-cell marks of the scan being inserted, as log_odds_; zero between scans.
+  std::vector<std::uint8_t> scan_marks_;
 };
 
 }  // namespace scanmatch
