@@ -63,11 +63,13 @@ void write_png_channels(const std::string& path, int width, int height, int chan
   for (int row = 0; row < height; ++row)
     std::memcpy(raw.data() + row * (row_bytes + 1) + 1, pixels.data() + row * row_bytes, row_bytes);
 
+  // zlib's default level: on freiburg-campus's 5979 x 6260 map, 10 % larger than the best level
+  // (0.97 against 0.88 MB) and 9x faster (0.34 against 3.2 s), a third of map2d's tail.
   uLongf compressed_size = compressBound(static_cast<uLong>(raw.size()));
   std::string compressed(compressed_size, '\0');
   if (compress2(reinterpret_cast<Bytef*>(compressed.data()), &compressed_size,
                 reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()),
-                Z_BEST_COMPRESSION) != Z_OK)
+                Z_DEFAULT_COMPRESSION) != Z_OK)
     fail(path, "zlib compression failed");
   compressed.resize(compressed_size);
 
