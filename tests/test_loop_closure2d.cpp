@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "scanmatch/core/error.hpp"
@@ -142,6 +143,56 @@ TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
                                << joined.free_violations << " " << joined.constraint;
   EXPECT_LT((joined.transform.translation() - truth.translation()).norm(), 0.05);
   EXPECT_NEAR(pose2_angle(joined.transform), pose2_angle(truth), 0.5 * M_PI / 180);
+}
+
+TEST(LoopClosure2D, PreparedScansVerifyAsTheScansThemselves) {
+  // One prepared submap serves several current scans and one prepared current scan several
+  // candidates, in any order, after the scans they were made from are gone: each verification as
+  // verify_loop_2d on the scans (accepted or not, to the last bit).
+  const Scans2D input = load_scans_2d("sim:corridor-2d", {}, 44);
+  ASSERT_EQ(input.scans.size(), 44u);
+  const auto scan = [&](std::size_t i) { return scan_from_laser(input.scans[i], 0.05, 0.0, 0.0); };
+  const auto pose = [&](std::size_t i) { return pose2(input.scans[i].pose); };
+  const LoopVerification2DOptions options;
+  const auto neighbours_of = [&](std::size_t candidate, std::vector<Scan2D>& scans) {
+    scans.clear();
+    for (std::size_t j = candidate - 6; j < candidate; ++j) scans.push_back(scan(j));
+    std::vector<PosedScan2D> posed;
+    for (std::size_t j = candidate - 6; j < candidate; ++j)
+      posed.push_back({&scans[j - (candidate - 6)], pose(candidate).inverse() * pose(j)});
+    return posed;
+  };
+  const auto same = [](const LoopVerification2D& a, const LoopVerification2D& b) {
+    return a.accepted == b.accepted && a.transform.matrix() == b.transform.matrix() &&
+           a.paired_fraction == b.paired_fraction && a.error == b.error &&
+           a.free_violations == b.free_violations && a.constraint == b.constraint &&
+           a.search_score == b.search_score && a.hessian == b.hessian &&
+           a.shifted_fraction == b.shifted_fraction && a.sliding == b.sliding &&
+           a.slide_direction == b.slide_direction;
+  };
+  std::vector<std::unique_ptr<LoopReference2D>> prepared;
+  for (const std::size_t candidate : {30u, 38u}) {
+    std::vector<Scan2D> scans;
+    prepared.push_back(std::make_unique<LoopReference2D>(scan(candidate),
+                                                         neighbours_of(candidate, scans), options));
+  }
+  std::size_t accepted = 0, rejected = 0;
+  for (const std::size_t current : {43u, 40u, 42u, 33u}) {
+    const LoopCurrent2D here(scan(current), options);
+    for (std::size_t c = 0; c < prepared.size(); ++c) {
+      const std::size_t candidate = c == 0 ? 30 : 38;
+      const Pose2 guess = pose(candidate).inverse() * pose(current) * pose2(0.3, -0.2, 0.04);
+      std::vector<Scan2D> scans;
+      const LoopVerification2D expected = verify_loop_2d(scan(current), scan(candidate), guess,
+                                                         options, neighbours_of(candidate, scans));
+      const LoopVerification2D v = verify_loop_2d(here, *prepared[c], guess, options);
+      EXPECT_TRUE(same(v, expected)) << current << " against " << candidate;
+      (expected.accepted ? accepted : rejected) += 1;
+    }
+  }
+  // Both outcomes were compared.
+  EXPECT_GT(accepted, 0u);
+  EXPECT_GT(rejected, 0u);
 }
 
 TEST(LoopClosure2D, AMatchAlongAPlainCorridorHoldsNothingAlongIt) {

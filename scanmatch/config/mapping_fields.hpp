@@ -200,6 +200,8 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("max_correction_per_m", o.max_correction_per_m, nullptr,
     "... plus this share of the path between the two keyframes");
   v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
+  v("keyframes_between_loops", o.keyframes_between_loops, nullptr,
+    "Keyframes without a search after one that added a loop");
   v("optimize_above", o.optimize_above, nullptr,
     "Optimize when a loop moves points 5 m away by more than this, m (0: every loop)");
   v("recheck_above", o.recheck_above, nullptr,

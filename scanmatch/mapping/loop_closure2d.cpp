@@ -113,7 +113,9 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, boo
     weak_fit_since_keyframe_ = false;
     places_.add(make_place_descriptor(scan, options_.descriptor));
     ++counts_.keyframes;
-    if (index % options_.search_every == 0) close_loops(index);
+    const bool pausing =
+        !loops().empty() && index <= last_loop_keyframe_ + options_.keyframes_between_loops;
+    if (index % options_.search_every == 0 && !pausing) close_loops(index);
   }
   graph_.add_frame(keyframes_.size() - 1, keyframes_.back().odometry.inverse() * odometry);
   counts_.total_ms += stopwatch.ms();
@@ -139,6 +141,7 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
       find_loop_candidates(keyframe, options_.skip_recent, graph(), places_, options_.candidates);
   const Pose2& here = graph().pose(keyframe);
   bool stale = false;
+  std::optional<LoopCurrent2D> current;  // for all of the keyframe's candidates
   for (const LoopCandidate& candidate : found.candidates) {
     const std::size_t k = candidate.keyframe;
     const bool linked = std::any_of(
@@ -146,21 +149,19 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
         [&](const Loop2D& l) { return l.from_keyframe == k && l.to_keyframe == keyframe; });
     if (linked) continue;
     ++counts_.candidates;
-    std::vector<PosedScan2D> neighbours;
+    std::vector<std::size_t> joined;
     if (options_.submap_keyframes > 0) {
       const std::size_t first = k > options_.submap_keyframes ? k - options_.submap_keyframes : 0;
       const std::size_t end = std::min(k + options_.submap_keyframes + 1, found.end);
       for (std::size_t j = first; j < end; ++j)
-        if (j != k)
-          neighbours.push_back(
-              {&keyframes_[j].points, graph().pose(k).inverse() * graph().pose(j)});
+        if (j != k) joined.push_back(j);
     }
     const Pose2 estimated = graph().pose(k).inverse() * here;
     // The descriptor knows the yaw only: the translation is left to the search window.
     const Pose2 initial = candidate.by_descriptor ? pose2(0.0, 0.0, candidate.yaw) : estimated;
-    const LoopVerification2D v =
-        verify_loop_2d(keyframes_[keyframe].points, keyframes_[k].points, initial,
-                       options_.verification, neighbours, estimated);
+    if (!current) current.emplace(keyframes_[keyframe].points, options_.verification);
+    const LoopVerification2D v = verify_loop_2d(*current, prepared_reference(k, joined), initial,
+                                                options_.verification, estimated);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;
@@ -179,6 +180,7 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     if (v.sliding) ++counts_.sliding;
     // How far the loop would move the keyframe's points at 5 m from the current estimate.
     if (moved_at_5m(estimated.inverse() * v.transform) >= options_.optimize_above) stale = true;
+    last_loop_keyframe_ = std::max(last_loop_keyframe_, keyframe);
     Loop2D loop;
     loop.from_keyframe = k;
     loop.to_keyframe = keyframe;
@@ -194,6 +196,34 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
                                               options_.sliding_information_kept));
   }
   return stale;
+}
+
+const LoopReference2D& LoopClosure2D::prepared_reference(std::size_t keyframe,
+                                                         const std::vector<std::size_t>& joined) {
+  PreparedReference wanted;
+  wanted.keyframe = keyframe;
+  for (const std::size_t j : joined)
+    wanted.joined.emplace_back(j, graph().pose(keyframe).inverse() * graph().pose(j));
+  const auto same = [&](const PreparedReference& p) {
+    return p.keyframe == wanted.keyframe &&
+           std::equal(p.joined.begin(), p.joined.end(), wanted.joined.begin(), wanted.joined.end(),
+                      [](const auto& a, const auto& b) {
+                        return a.first == b.first && a.second.matrix() == b.second.matrix();
+                      });
+  };
+  const auto found = std::find_if(prepared_.begin(), prepared_.end(), same);
+  if (found != prepared_.end()) {
+    // The most recently used last.
+    std::rotate(found, found + 1, prepared_.end());
+    return *prepared_.back().reference;
+  }
+  std::vector<PosedScan2D> neighbours;
+  for (const auto& [j, pose] : wanted.joined) neighbours.push_back({&keyframes_[j].points, pose});
+  wanted.reference = std::make_unique<LoopReference2D>(keyframes_[keyframe].points, neighbours,
+                                                       options_.verification);
+  if (prepared_.size() >= kPreparedReferences) prepared_.erase(prepared_.begin());
+  prepared_.push_back(std::move(wanted));
+  return *prepared_.back().reference;
 }
 
 bool LoopClosure2D::agrees_turned_at_open_rotation(std::size_t older, std::size_t newer,

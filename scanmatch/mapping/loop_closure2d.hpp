@@ -13,6 +13,8 @@
 // when to search and when to optimize.
 
 #include <cstddef>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "scanmatch/core/scan2d.hpp"
@@ -109,8 +111,13 @@ struct LoopClosure2DOptions {
   /// about it to the loop's heading.
   double max_correction = 1.0;
   double max_correction_per_m = 0.05;
-  /// Loop edges are looked for at every this-many keyframes (1: each one).
+  /// Loop edges are looked for at every this-many keyframes (1: each one) ...
   std::size_t search_every = 1;
+  /// ... and not at the next this-many keyframes after one that added a loop edge: on a second
+  /// pass every keyframe revisits a place, and a loop every few metres holds the graph as well
+  /// as one per keyframe at a fraction of the verification cost, loop closure's main cost
+  /// (LoopClosure3DOptions likewise). 0: no pause.
+  std::size_t keyframes_between_loops = 0;
   /// The graph is optimized when a new loop edge would move the keyframe's points 5 m away by
   /// more than this (m) from the current estimate; loops that agree with it wait for the next
   /// optimization (finish() always runs one). On intel 0.1 ran a quarter of the optimizations
@@ -230,12 +237,26 @@ class LoopClosure2D {
   void loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
                             const Scan2D& current, const Pose2& measurement, bool weak_fit) const;
   void optimize();
+  /// Keyframe `keyframe` joined by the keyframes `joined` at their current relative poses,
+  /// prepared for verification (kept for the next candidates: a keyframe is often the candidate
+  /// of several new keyframes while the estimate stays).
+  const LoopReference2D& prepared_reference(std::size_t keyframe,
+                                            const std::vector<std::size_t>& joined);
+  struct PreparedReference {
+    std::size_t keyframe = 0;
+    std::vector<std::pair<std::size_t, Pose2>> joined;  ///< each keyframe in `keyframe`'s frame
+    std::unique_ptr<const LoopReference2D> reference;
+  };
+  /// The prepared references kept (bounded memory), the most recently used last.
+  static constexpr std::size_t kPreparedReferences = 16;
+  std::vector<PreparedReference> prepared_;
 
   LoopClosure2DOptions options_;
   KeyframeGraph<2, Loop2D> graph_;
   PlaceDatabase2D places_;
   std::vector<Keyframe> keyframes_;
   LoopClosure2DCounts counts_;
+  std::size_t last_loop_keyframe_ = 0;  ///< the newest keyframe that added a loop edge
 };
 
 }  // namespace scanmatch

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <unordered_map>
 #include <utility>
@@ -185,35 +187,103 @@ OverlapCheck check_overlap(const Scan2D& from, const OverlapTarget& onto, const 
 
 }  // namespace
 
+struct LoopCurrent2D::Impl {
+  Impl(const Scan2D& s, double pair, double gap)
+      : scan(s), finite(finite_scan(s)), pair_distance(pair), fill_gap(gap) {}
+  const OverlapTarget& overlap() const {
+    std::call_once(
+        built, [&] { target = std::make_unique<OverlapTarget>(scan, pair_distance, fill_gap); });
+    return *target;
+  }
+  Scan2D scan;
+  bool finite;
+  double pair_distance, fill_gap;
+  mutable std::once_flag built;
+  mutable std::unique_ptr<OverlapTarget> target;
+};
+
+LoopCurrent2D::LoopCurrent2D(const Scan2D& scan, const LoopVerification2DOptions& options)
+    : impl_(std::make_unique<Impl>(scan, options.pair_distance,
+                                   Registration2DOptions{}.search_fill_gap)) {}
+LoopCurrent2D::~LoopCurrent2D() = default;
+
+struct LoopReference2D::Impl {
+  Impl(const Scan2D& c, const std::vector<PosedScan2D>& neighbours, double pair, double gap)
+      : candidate(c),
+        candidate_finite(finite_scan(c)),
+        joined(!neighbours.empty()),
+        pair_distance(pair),
+        fill_gap(gap),
+        registration(joined ? submap : candidate) {
+    if (!joined) return;
+    submap = candidate;
+    submap.circular = false;
+    neighbour_scans.reserve(neighbours.size());  // `views` points into it
+    views.push_back({&candidate, Pose2::Identity()});
+    for (const PosedScan2D& n : neighbours) {
+      if (!n.scan || !finite_scan(*n.scan) || !n.pose.matrix().allFinite()) continue;
+      for (const Eigen::Vector2d& p : n.scan->points) submap.points.push_back(n.pose * p);
+      neighbour_scans.push_back(*n.scan);
+      views.push_back({&neighbour_scans.back(), n.pose});
+    }
+  }
+  const Scan2D& reference() const { return joined ? submap : candidate; }
+  const OverlapTarget& overlap() const {
+    std::call_once(built, [&] {
+      target = joined ? std::make_unique<OverlapTarget>(submap, views, pair_distance, fill_gap)
+                      : std::make_unique<OverlapTarget>(candidate, pair_distance, fill_gap);
+    });
+    return *target;
+  }
+  Scan2D candidate;
+  bool candidate_finite, joined;
+  double pair_distance, fill_gap;
+  Scan2D submap;                        // the candidate joined by its neighbours (`joined`)
+  std::vector<Scan2D> neighbour_scans;  // the usable ones, as `views` sees them
+  std::vector<PosedScan2D> views;       // each scan and its pose, for its free space (`joined`)
+  Reference2D registration;             // of reference(), made on first use: declared after it
+  mutable std::once_flag built;
+  mutable std::unique_ptr<OverlapTarget> target;
+};
+
+LoopReference2D::LoopReference2D(const Scan2D& candidate,
+                                 const std::vector<PosedScan2D>& candidate_neighbours,
+                                 const LoopVerification2DOptions& options)
+    : impl_(std::make_unique<Impl>(candidate, candidate_neighbours, options.pair_distance,
+                                   Registration2DOptions{}.search_fill_gap)) {}
+LoopReference2D::~LoopReference2D() = default;
+
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
                                   const Pose2& initial, const LoopVerification2DOptions& options,
                                   const std::vector<PosedScan2D>& candidate_neighbours,
                                   const std::optional<Pose2>& anchor) {
+  return verify_loop_2d(LoopCurrent2D(current, options),
+                        LoopReference2D(candidate, candidate_neighbours, options), initial, options,
+                        anchor);
+}
+
+LoopVerification2D verify_loop_2d(const LoopCurrent2D& prepared_current,
+                                  const LoopReference2D& prepared_candidate, const Pose2& initial,
+                                  const LoopVerification2DOptions& options,
+                                  const std::optional<Pose2>& anchor) {
+  const LoopCurrent2D::Impl& here = prepared_current.impl();
+  const LoopReference2D::Impl& there = prepared_candidate.impl();
+  const Scan2D& current = here.scan;
+  const Scan2D& candidate = there.candidate;
   const Pose2 slide_anchor = anchor.value_or(initial);
   LoopVerification2D out;
   out.transform = initial;
   const std::size_t min_points = std::max<std::size_t>(options.min_points, 3);
-  if (current.points.size() < min_points || candidate.points.size() < min_points ||
-      !finite_scan(current) || !finite_scan(candidate) || !initial.matrix().allFinite())
+  if (current.points.size() < min_points || candidate.points.size() < min_points || !here.finite ||
+      !there.candidate_finite || !initial.matrix().allFinite())
     return out;
   Registration2DOptions r;
   r.method = options.method;
   r.max_correspondence_distance = options.max_correspondence_distance;
   r.search_window = 0.0;  // searched here, so that a place nothing fits ends the check early
-  const bool joined = !candidate_neighbours.empty();
-  Scan2D submap;
-  std::vector<PosedScan2D> views{{&candidate, Pose2::Identity()}};
-  if (joined) {
-    submap = candidate;
-    submap.circular = false;
-    for (const PosedScan2D& n : candidate_neighbours) {
-      if (!n.scan || !finite_scan(*n.scan) || !n.pose.matrix().allFinite()) continue;
-      for (const Eigen::Vector2d& p : n.scan->points) submap.points.push_back(n.pose * p);
-      views.push_back(n);
-    }
-  }
-  const Scan2D& reference_scan = joined ? submap : candidate;
-  const Reference2D registration_reference(reference_scan);  // also for the sliding re-fit
+  const bool joined = there.joined;
+  const Scan2D& reference_scan = there.reference();
+  const Reference2D& registration_reference = there.registration;  // also for the sliding re-fit
   try {
     const CorrelativeMatch match = correlative_match(
         current, reference_scan, initial, options.search_window, options.search_angle,
@@ -225,8 +295,8 @@ LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate
     return out;  // too few usable points for the method: not verifiable, so not a loop
   }
   if (!out.transform.matrix().allFinite()) return out;
-  const OverlapTarget reference(reference_scan, views, options.pair_distance, r.search_fill_gap);
-  const OverlapTarget current_target(current, options.pair_distance, r.search_fill_gap);
+  const OverlapTarget& reference = there.overlap();
+  const OverlapTarget& current_target = here.overlap();
   // Fills out's checks at out.transform.
   struct Assessment {
     double forward_paired;  // the current scan's share paired onto the reference

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,6 +92,43 @@ struct PosedScan2D {
   Pose2 pose = Pose2::Identity();
 };
 
+/// The current scan of verify_loop_2d with what the checks build of it (its filled surfaces, their
+/// hash, the free space it saw), prepared once for all of its candidates. Holds a copy of the
+/// scan; `options` must be those of the verifications it is used in.
+class LoopCurrent2D {
+ public:
+  LoopCurrent2D(const Scan2D& scan, const LoopVerification2DOptions& options);
+  ~LoopCurrent2D();
+  LoopCurrent2D(const LoopCurrent2D&) = delete;
+  LoopCurrent2D& operator=(const LoopCurrent2D&) = delete;
+
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// A candidate scan joined by its neighbours (posed in its frame) as verify_loop_2d registers and
+/// checks against it: the joined scan, its k-d tree and fitted lines, its filled surfaces and the
+/// free space each scan saw, each made on first use and then kept for every current scan verified
+/// against it. Holds copies of the scans (the neighbours' poses are fixed at construction);
+/// `options` must be those of the verifications it is used in.
+class LoopReference2D {
+ public:
+  LoopReference2D(const Scan2D& candidate, const std::vector<PosedScan2D>& candidate_neighbours,
+                  const LoopVerification2DOptions& options);
+  ~LoopReference2D();
+  LoopReference2D(const LoopReference2D&) = delete;
+  LoopReference2D& operator=(const LoopReference2D&) = delete;
+
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Verifies that `current` and `candidate` show the same place, starting from `initial` (current
 /// in the candidate's frame). Never throws for bad scans (too few or non-finite points): rejects.
 /// With `candidate_neighbours` (scans taken near the candidate, posed in its frame) the current
@@ -103,6 +141,10 @@ struct PosedScan2D {
 LoopVerification2D verify_loop_2d(const Scan2D& current, const Scan2D& candidate,
                                   const Pose2& initial, const LoopVerification2DOptions& options,
                                   const std::vector<PosedScan2D>& candidate_neighbours = {},
+                                  const std::optional<Pose2>& anchor = std::nullopt);
+/// verify_loop_2d with both sides prepared: the same result, without building them again.
+LoopVerification2D verify_loop_2d(const LoopCurrent2D& current, const LoopReference2D& candidate,
+                                  const Pose2& initial, const LoopVerification2DOptions& options,
                                   const std::optional<Pose2>& anchor = std::nullopt);
 
 }  // namespace scanmatch
