@@ -188,15 +188,27 @@ RevisitConsistency2D revisit_consistency_2d(const std::vector<Scan2D>& scans,
         for (int dy = -1; dy <= 1; ++dy) {
           const auto it = cells.find(key(c + Eigen::Vector2i(dx, dy)));
           if (it == cells.end()) continue;
-          for (const std::size_t j : it->second) {
-            const std::size_t a = scan_of[i], b = scan_of[j];
-            if ((a > b ? a - b : b - a) < revisit_gap) continue;
-            const double d = (world[j] - world[i]).squaredNorm();
-            if (d <= best) {
-              best = d;
-              nearest = j;
+          // A cell lists its points by scan: the query's own visit (within revisit_gap scans) is
+          // one stretch of it, skipped whole (most of a cell where the sensor moved slowly).
+          const std::vector<std::size_t>& in_cell = it->second;
+          const std::size_t a = scan_of[i];
+          const auto own_begin =
+              std::partition_point(in_cell.begin(), in_cell.end(),
+                                   [&](std::size_t j) { return scan_of[j] + revisit_gap <= a; });
+          const auto own_end = std::partition_point(own_begin, in_cell.end(), [&](std::size_t j) {
+            return scan_of[j] < a + revisit_gap;
+          });
+          const auto visit = [&](auto begin, auto end) {
+            for (auto j = begin; j != end; ++j) {
+              const double d = (world[*j] - world[i]).squaredNorm();
+              if (d <= best) {
+                best = d;
+                nearest = *j;
+              }
             }
-          }
+          };
+          visit(in_cell.begin(), own_begin);
+          visit(own_end, in_cell.end());
         }
       if (nearest < world.size())
         distance[q] = std::min(surface_distance(i, nearest, best), max_distance);
