@@ -114,6 +114,14 @@ TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
   close(eager);
   EXPECT_GT(eager.counts().optimizations, c.optimizations);
   EXPECT_NEAR(absolute_trajectory_error_2d(reference, eager.poses()).rmse, after.rmse, 0.03);
+  // A keyframe's pause after each one that added a loop verifies fewer candidates; loops a
+  // keyframe or two apart still hold the map.
+  LoopClosure2DOptions paused;
+  paused.keyframes_between_loops = 1;
+  LoopClosure2D sparse(paused);
+  close(sparse);
+  EXPECT_LT(sparse.counts().candidates, c.candidates);
+  EXPECT_LT(absolute_trajectory_error_2d(reference, sparse.poses()).rmse, 0.5 * before.rmse);
 }
 
 TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
