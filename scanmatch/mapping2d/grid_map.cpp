@@ -29,34 +29,47 @@ bool cell_index_in_range(const Eigen::Vector2d& p) {
   return std::abs(p.x()) < kMaxCellIndex && std::abs(p.y()) < kMaxCellIndex;
 }
 
-// Calls visit(cell) for every cell the segment a -> b (in cell units) passes through, from a's
-// cell up to but excluding b's cell (Amanatides & Woo). The number of steps is fixed by the
-// integer distance between the end cells, so rounding can never overshoot the end cell.
+// Calls visit(index) with the storage index (`origin`: the lattice cell of index 0, `width`: cells
+// a row) of every cell the segment a -> b (in cell units) passes through, from a's cell up to but
+// excluding b's cell (Amanatides & Woo). The number of steps is fixed by the integer distance
+// between the end cells, so rounding can never overshoot the end cell. Scalars and a running
+// index: the rays of a long-range scan visit ~10^6 cells.
 template <class Visit>
-void for_each_cell_before_end(const Eigen::Vector2d& a, const Eigen::Vector2d& b, Visit&& visit) {
-  Eigen::Vector2i cell = floor_cell(a);
+void for_each_index_before_end(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                               const Eigen::Vector2i& origin, std::int64_t width, Visit&& visit) {
+  const Eigen::Vector2i cell = floor_cell(a);
   const Eigen::Vector2i end = floor_cell(b);
-  const Eigen::Vector2d direction = b - a;
-  const Eigen::Vector2i step(end.x() >= cell.x() ? 1 : -1, end.y() >= cell.y() ? 1 : -1);
-  Eigen::Vector2i remaining((end - cell).cwiseAbs());
+  const double dx = b.x() - a.x(), dy = b.y() - a.y();
+  const int step_x = end.x() >= cell.x() ? 1 : -1, step_y = end.y() >= cell.y() ? 1 : -1;
+  int remaining_x = std::abs(end.x() - cell.x()), remaining_y = std::abs(end.y() - cell.y());
   constexpr double kNever = std::numeric_limits<double>::infinity();
   // Ray parameter (0 at a, 1 at b) of the next boundary crossed along each axis, and between two
   // boundaries. An axis with steps remaining has a non-zero direction of the step's sign.
-  Eigen::Vector2d next_crossing(kNever, kNever);
-  Eigen::Vector2d crossing_interval(kNever, kNever);
-  for (int axis = 0; axis < 2; ++axis) {
-    if (remaining[axis] == 0) continue;
-    const double boundary = step[axis] > 0 ? cell[axis] + 1.0 : cell[axis];
-    next_crossing[axis] = (boundary - a[axis]) / direction[axis];
-    crossing_interval[axis] = 1.0 / std::abs(direction[axis]);
+  double next_x = kNever, next_y = kNever, interval_x = kNever, interval_y = kNever;
+  if (remaining_x != 0) {
+    const double boundary = step_x > 0 ? cell.x() + 1.0 : cell.x();
+    next_x = (boundary - a.x()) / dx;
+    interval_x = 1.0 / std::abs(dx);
   }
-  while (remaining.x() + remaining.y() > 0) {
-    visit(cell);
-    const int axis =
-        remaining.y() == 0 || (remaining.x() > 0 && next_crossing.x() < next_crossing.y()) ? 0 : 1;
-    cell[axis] += step[axis];
-    next_crossing[axis] += crossing_interval[axis];
-    --remaining[axis];
+  if (remaining_y != 0) {
+    const double boundary = step_y > 0 ? cell.y() + 1.0 : cell.y();
+    next_y = (boundary - a.y()) / dy;
+    interval_y = 1.0 / std::abs(dy);
+  }
+  std::int64_t index =
+      static_cast<std::int64_t>(cell.y() - origin.y()) * width + (cell.x() - origin.x());
+  const std::int64_t row_step = step_y * width;
+  while (remaining_x + remaining_y > 0) {
+    visit(index);
+    if (remaining_y == 0 || (remaining_x > 0 && next_x < next_y)) {
+      index += step_x;
+      next_x += interval_x;
+      --remaining_x;
+    } else {
+      index += row_step;
+      next_y += interval_y;
+      --remaining_y;
+    }
   }
 }
 
@@ -133,20 +146,19 @@ void OccupancyGrid::insert_scan(const Eigen::Isometry2d& sensor_pose,
   if (scan_marks_.size() != log_odds_.size()) scan_marks_.assign(log_odds_.size(), kUntouched);
   std::vector<std::int64_t> touched;
   touched.reserve(8 * (hits.size() + misses.size()));
-  const auto mark = [&](const Eigen::Vector2i& cell, std::uint8_t kind) {
-    const std::int64_t index = storage_index(cell);
+  const auto mark = [&](std::int64_t index, std::uint8_t kind) {
     std::uint8_t& m = scan_marks_[static_cast<std::size_t>(index)];
     if (m == kUntouched) touched.push_back(index);
     m = std::max(m, kind);
   };
-  const auto add_free = [&](const Eigen::Vector2i& cell) { mark(cell, kFreeMark); };
+  const auto add_free = [&](std::int64_t index) { mark(index, kFreeMark); };
   for (const Eigen::Vector2d& hit : hits) {
-    for_each_cell_before_end(sensor, hit, add_free);
-    mark(floor_cell(hit), kHitMark);
+    for_each_index_before_end(sensor, hit, origin_cell_, width_, add_free);
+    mark(storage_index(floor_cell(hit)), kHitMark);
   }
   for (const Eigen::Vector2d& miss : misses) {
-    for_each_cell_before_end(sensor, miss, add_free);
-    add_free(floor_cell(miss));
+    for_each_index_before_end(sensor, miss, origin_cell_, width_, add_free);
+    add_free(storage_index(floor_cell(miss)));
   }
   for (const std::int64_t index : touched) {
     std::uint8_t& m = scan_marks_[static_cast<std::size_t>(index)];
