@@ -2,8 +2,6 @@
 // (loop_closure2d.hpp).
 #include "scanmatch/mapping/loop_closure2d.hpp"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -142,14 +140,8 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
   const LoopCandidates found =
       find_loop_candidates(keyframe, options_.skip_recent, graph(), places_, options_.candidates);
   const Pose2& here = graph().pose(keyframe);
-  // Each candidate not yet joined to this keyframe, with its prepared submap.
-  struct Trial {
-    std::size_t keyframe;
-    std::shared_ptr<const LoopReference2D> reference;
-    Pose2 estimated, initial;
-    LoopVerification2D result;
-  };
-  std::vector<Trial> trials;
+  bool stale = false;
+  std::optional<LoopCurrent2D> current;  // for all of the keyframe's candidates
   for (const LoopCandidate& candidate : found.candidates) {
     const std::size_t k = candidate.keyframe;
     const bool linked = std::any_of(
@@ -167,21 +159,9 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     const Pose2 estimated = graph().pose(k).inverse() * here;
     // The descriptor knows the yaw only: the translation is left to the search window.
     const Pose2 initial = candidate.by_descriptor ? pose2(0.0, 0.0, candidate.yaw) : estimated;
-    trials.push_back({k, prepared_reference(k, joined), estimated, initial, {}});
-  }
-  if (trials.empty()) return false;
-  // Verified side by side: a verification reads its two prepared scans only, and the loops are
-  // added below in the candidates' order, as one after the other would add them.
-  const LoopCurrent2D current(keyframes_[keyframe].points, options_.verification);
-  tbb::parallel_for(std::size_t{0}, trials.size(), [&](std::size_t t) {
-    trials[t].result = verify_loop_2d(current, *trials[t].reference, trials[t].initial,
-                                      options_.verification, trials[t].estimated);
-  });
-  bool stale = false;
-  for (const Trial& trial : trials) {
-    const std::size_t k = trial.keyframe;
-    const Pose2& estimated = trial.estimated;
-    const LoopVerification2D& v = trial.result;
+    if (!current) current.emplace(keyframes_[keyframe].points, options_.verification);
+    const LoopVerification2D v = verify_loop_2d(*current, prepared_reference(k, joined), initial,
+                                                options_.verification, estimated);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;
@@ -218,8 +198,8 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
   return stale;
 }
 
-std::shared_ptr<const LoopReference2D> LoopClosure2D::prepared_reference(
-    std::size_t keyframe, const std::vector<std::size_t>& joined) {
+const LoopReference2D& LoopClosure2D::prepared_reference(std::size_t keyframe,
+                                                         const std::vector<std::size_t>& joined) {
   PreparedReference wanted;
   wanted.keyframe = keyframe;
   for (const std::size_t j : joined)
@@ -235,15 +215,15 @@ std::shared_ptr<const LoopReference2D> LoopClosure2D::prepared_reference(
   if (found != prepared_.end()) {
     // The most recently used last.
     std::rotate(found, found + 1, prepared_.end());
-    return prepared_.back().reference;
+    return *prepared_.back().reference;
   }
   std::vector<PosedScan2D> neighbours;
   for (const auto& [j, pose] : wanted.joined) neighbours.push_back({&keyframes_[j].points, pose});
-  wanted.reference = std::make_shared<const LoopReference2D>(keyframes_[keyframe].points,
-                                                             neighbours, options_.verification);
+  wanted.reference = std::make_unique<LoopReference2D>(keyframes_[keyframe].points, neighbours,
+                                                       options_.verification);
   if (prepared_.size() >= kPreparedReferences) prepared_.erase(prepared_.begin());
   prepared_.push_back(std::move(wanted));
-  return prepared_.back().reference;
+  return *prepared_.back().reference;
 }
 
 bool LoopClosure2D::agrees_turned_at_open_rotation(std::size_t older, std::size_t newer,
