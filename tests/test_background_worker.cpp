@@ -35,59 +35,62 @@ TEST(BackgroundWorker, WorksEveryItemInOrderOnOneOtherThread) {
   }
 }
 
-TEST(BackgroundWorker, AFullQueueHoldsTheCallerBack) {
+// Work that holds every item until released, counting the items done.
+struct GatedWork {
   std::atomic<bool> release{false};
   std::atomic<int> done{0};
-  BackgroundWorker<int> worker(
-      [&](int&) {
-        while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        ++done;
-      },
-      2);
-  // One item in the work, two queued: the fourth push waits until the work goes on.
-  for (int i = 0; i < 3; ++i) worker.push(i);
+  auto work() {
+    return [this](int&) {
+      while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      ++done;
+    };
+  }
+};
+
+// Pushes `item` from another thread while the work is held and looks 50 ms later: was the push
+// still waiting, and how many items were done by then. Then releases the work and finishes.
+struct HeldPush {
+  bool waited = false;
+  int done_meanwhile = 0;
+};
+HeldPush push_while_held(BackgroundWorker<int>& worker, GatedWork& gate, int item) {
   std::atomic<bool> pushed{false};
   std::thread caller([&] {
-    worker.push(3);
+    worker.push(item);
     pushed = true;
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  EXPECT_FALSE(pushed.load());
-  EXPECT_EQ(done.load(), 0);
-  release = true;
+  const HeldPush held{!pushed.load(), gate.done.load()};
+  gate.release = true;
   caller.join();
   worker.finish();
   EXPECT_TRUE(pushed.load());
-  EXPECT_EQ(done.load(), 4);
+  return held;
+}
+
+TEST(BackgroundWorker, AFullQueueHoldsTheCallerBack) {
+  GatedWork gate;
+  BackgroundWorker<int> worker(gate.work(), 2);
+  // One item in the work, two queued: the fourth push waits until the work goes on.
+  for (int i = 0; i < 3; ++i) worker.push(i);
+  const HeldPush held = push_while_held(worker, gate, 3);
+  EXPECT_TRUE(held.waited);
+  EXPECT_EQ(held.done_meanwhile, 0);
+  EXPECT_EQ(gate.done.load(), 4);
   EXPECT_GT(worker.waited_ms(), 0.0);
 }
 
 TEST(BackgroundWorker, TheQueueIsBoundedByWeightAndTakesAHeavyItemWhenEmpty) {
   // Items weigh their value; the queue holds 10. A heavier item still goes into an empty queue
   // (nothing would ever make room for it), lighter ones queue until 10 and the next one waits.
-  std::atomic<bool> release{false};
-  std::atomic<int> done{0};
-  BackgroundWorker<int> worker(
-      [&](int&) {
-        while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        ++done;
-      },
-      10, true, [](const int& i) { return static_cast<std::size_t>(i); });
+  GatedWork gate;
+  BackgroundWorker<int> worker(gate.work(), 10, true,
+                               [](const int& i) { return static_cast<std::size_t>(i); });
   worker.push(100);
   std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the worker holds it
   for (int i = 0; i < 3; ++i) worker.push(3);                  // 9 of 10 queued
-  std::atomic<bool> pushed{false};
-  std::thread caller([&] {
-    worker.push(3);
-    pushed = true;
-  });
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  EXPECT_FALSE(pushed.load());
-  release = true;
-  caller.join();
-  worker.finish();
-  EXPECT_TRUE(pushed.load());
-  EXPECT_EQ(done.load(), 5);
+  EXPECT_TRUE(push_while_held(worker, gate, 3).waited);
+  EXPECT_EQ(gate.done.load(), 5);
 }
 
 TEST(BackgroundWorker, TheWorksExceptionReachesTheCaller) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "scanmatch/core/se3.hpp"
@@ -85,6 +87,19 @@ TEST(BeamElevation, ABiasedCarPitchesAndTheCorrectionTakesItOut) {
   EXPECT_LT(std::abs(unbiased), 0.1);
   EXPECT_LT(drifting, -0.3 * static_cast<double>(frames) / 80.0);
   EXPECT_LT(std::abs(taken_out), 0.1);
+}
+
+TEST(BeamElevation, TheSimulatorRefusesABiasBeyondFiveDegrees) {
+  sim::SimOptions options;
+  options.preset = "campus-os1";
+  options.frames = 1;
+  for (const double bias : {6.0, -90.0, std::numeric_limits<double>::quiet_NaN()}) {
+    options.elevation_bias_deg = bias;
+    EXPECT_NE(
+        testing::error_of([&] { sim::Simulator simulator(options); }).find("--elevation-bias"),
+        std::string::npos)
+        << bias;
+  }
 }
 
 }  // namespace scanmatch

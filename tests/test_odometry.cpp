@@ -468,6 +468,29 @@ TEST(Odometry, NewConfigurationFieldsAreValidatedByName) {
   EXPECT_EQ(error_for([](OdometryConfig&) {}), "");
 }
 
+// The global start's and the elevation correction's fields: each bad value is named.
+TEST(Odometry, GlobalStartAndElevationFieldsAreValidatedByName) {
+  const auto error_for = [](const auto& set) {
+    OdometryConfig c;
+    set(c);
+    return scanmatch::testing::error_of([&] { Odometry odometry(c); });
+  };
+  EXPECT_NE(
+      error_for([](OdometryConfig& c) { c.global_start_below = 1.5; }).find("global_start_below"),
+      std::string::npos);
+  EXPECT_NE(
+      error_for([](OdometryConfig& c) { c.global_start_gain = 0.5; }).find("global_start_gain"),
+      std::string::npos);
+  EXPECT_NE(error_for([](OdometryConfig& c) {
+              c.elevation_correction_deg = std::numeric_limits<double>::quiet_NaN();
+            }).find("elevation_correction_deg"),
+            std::string::npos);
+  EXPECT_NE(error_for([](OdometryConfig& c) {
+              c.elevation_correction_deg = 20.0;
+            }).find("elevation_correction_deg"),
+            std::string::npos);
+}
+
 TEST(Odometry, InvalidConfigurationsAreRejected) {
   EXPECT_THROW(Odometry{with_method("magic")}, Error);
   OdometryConfig c;
