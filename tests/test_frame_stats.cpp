@@ -95,11 +95,12 @@ TEST(FrameStats, TimingCsvRowsKeepTheirNumberFormats) {
   s.prior_uncertain = true;
   s.recovered = true;
   s.prior_miss_m = 0.123456789;
+  s.elevation_correction_deg = 0.2488;
   EXPECT_EQ(timing_csv_row(4, 1234.5, s),
             "4,1234.500000,1.235,2.000,0.001,10.100,13.400,120000,8123,17,1.23457e+06,1,1,1,1,0,0,"
-            "0.123457,0,0,0,0");
+            "0.123457,0,0,0,0,0.2488");
   EXPECT_EQ(timing_csv_row(0, 0.0, FrameStats{}),
-            "0,0.000000,0.000,0.000,0.000,0.000,0.000,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0");
+            "0,0.000000,0.000,0.000,0.000,0.000,0.000,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0");
 }
 
 TEST(FrameStats, EveryDescribedFieldRoundTripsThroughTimingCsv) {

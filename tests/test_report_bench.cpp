@@ -100,8 +100,9 @@ TEST(Report, EachRunShowsItsStepErrorAndHealthOverFrames) {
       0);
   // Every run folder counts its health flags, the recoveries among them.
   const auto summary = nlohmann::json::parse(scanmatch::testing::read_text(with + "/summary.json"));
-  for (const char* key : {"uncertain_priors", "recoveries", "global_starts", "thin_map_frames",
-                          "coarse_fine_disagreements", "median_fine_paired_fraction"})
+  for (const char* key :
+       {"uncertain_priors", "recoveries", "global_starts", "thin_map_frames",
+        "coarse_fine_disagreements", "median_fine_paired_fraction", "elevation_correction_deg"})
     EXPECT_TRUE(summary.at("health").contains(key)) << key;
   // The same run without its ground truth: nothing to measure the steps against.
   std::filesystem::copy(with, without);

@@ -13,6 +13,9 @@ void describe(OdometryConfig& c, Visitor& v) {
   v("max_range", c.max_range, "--max-range", "Farther points are dropped, m");
   v("elevation_correction_deg", c.elevation_correction_deg, "--elevation-correction",
     "Lower every point's elevation by this many degrees first (a beam calibration error)");
+  v("elevation_estimate", c.elevation_estimate, "--no-elevation-estimate",
+    "Do not estimate a beam elevation bias from the first moving frames (without "
+    "--elevation-correction, a clear one is taken out of the frames after them)");
   v("ndt_resolution", c.ndt_resolution, "--ndt-resolution",
     "ctf-icp: the coarse stage's NDT grid of the previous frame, m");
   v("ndt_neighbours", c.ndt_neighbours, nullptr, "ctf-icp coarse: voxels per point");

@@ -33,6 +33,7 @@ struct FrameStats {
   double prior_miss_m = 0, prior_miss_deg = 0;
   double fine_paired_fraction = 0;
   double coarse_fine_m = 0, coarse_fine_deg = 0;
+  double elevation_correction_deg = 0;
 };
 
 template <typename Stats, typename Visitor>
@@ -74,6 +75,9 @@ void describe(Stats& s, Visitor& v) {
     "ctf-icp: distance between the coarse and the fine result, m (large: the stages disagree)");
   v("coarse_fine_deg", s.coarse_fine_deg,
     "ctf-icp: rotation between the coarse and fine result, deg");
+  v("elevation_correction_deg", s.elevation_correction_deg,
+    "the beam elevation correction the frame was preprocessed with, deg (elevation_estimate: 0 "
+    "until the first moving frames decide one)");
 }
 
 // timing.csv: a header line "index,timestamp,<every key of describe()>", then a row a frame.

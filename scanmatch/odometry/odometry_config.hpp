@@ -19,6 +19,10 @@ struct OdometryConfig {
   /// beams point lower than its points say (geometry/beam_elevation.hpp; docs/odometry.md,
   /// "riverside02_keyframes: what is left"). 0: as delivered.
   double elevation_correction_deg = 0.0;
+  /// Without an elevation_correction_deg: estimate the bias from the first moving frame pairs and
+  /// take it out of the frames after them where the pairs agree on one
+  /// (odometry/elevation_estimate.hpp).
+  bool elevation_estimate = true;
   // Coarse stage (ctf-icp): NDT against the previous frame.
   double ndt_resolution = 1.0;     ///< m, the NDT grid of the previous frame
   int ndt_neighbours = 1;          ///< voxels per point: 1, 7 or 27

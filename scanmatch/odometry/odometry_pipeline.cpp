@@ -28,7 +28,8 @@ OdometryPipeline::OdometryPipeline(const OdometryConfig& config, bool keep_attri
       preprocessor_(preprocess_options(config, keep_attributes)),
       motion_(config),
       wants_map_points_(map_points),
-      deskews_again_(deskews_again) {
+      deskews_again_(deskews_again),
+      estimating_elevation_(config.elevation_estimate && config.elevation_correction_deg == 0.0) {
   check_odometry_config(config);
   // The one place the thread count reaches the solver: every stage is made from config().
   config_.registration.solver.num_threads = config.threads;
@@ -38,6 +39,8 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   const Stopwatch total;
   stats_ = FrameStats{};
   stats_.points_in = frame.size();
+  stats_.elevation_correction_deg =
+      preprocessor_.options().elevation_correction * kDegreesPerRadian;
   if (frames_ == kWorldSettlesAfter) settled_first_frame_ = PointCloud{};  // handed out by now
   if (frames_ == 0) {
     timed_frames_ = frame.has_time();
@@ -121,6 +124,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   }
   if (frames_ < kWorldSettlesAfter) early_starts_[frames_] = reported;
   reported = world_from_internal_ * reported;
+  if (estimating_elevation_) offer_elevation_pair(down);
   update_reference(std::move(down), map_points_, pose_, stats_.bridged, stats_);
   ++frames_;
   stats_.total_ms = total.ms();
@@ -173,6 +177,44 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
   down = std::move(again);
   map_points_ = std::move(again_map_points);
   return result;
+}
+
+void OdometryPipeline::offer_elevation_pair(const PointCloud& frame) {
+  const Stopwatch time;
+  // The correction this frame was preprocessed with: a pair of frames corrected alike measures
+  // the bias left over.
+  const double corrected = stats_.elevation_correction_deg / kDegreesPerRadian;
+  if (stats_.bridged) {
+    elevation_previous_ = PointCloud{};  // no trusted relative pose to the next frame
+    return;
+  }
+  const Pose step = elevation_previous_pose_.inverse() * pose_;
+  if (elevation_previous_correction_ != corrected) {
+    // The previous frame was preprocessed before the correction changed: correct it alike.
+    const ElevationTurn change(elevation_previous_correction_ - corrected);
+    for (Point& p : elevation_previous_.points) p = change(p);
+    elevation_previous_correction_ = corrected;
+  }
+  const bool paired = !elevation_previous_.empty();
+  if (paired && step.translation().norm() >= ElevationEstimate::kMinStep) {
+    ElevationBiasFromPair pair = estimate_elevation_bias(elevation_previous_, frame, step);
+    pair.bias += corrected;
+    elevation_.add(pair);
+    preprocessor_.set_elevation_correction(elevation_.correction());
+    if (elevation_.decided()) {
+      estimating_elevation_ = false;
+      elevation_previous_ = PointCloud{};
+      stats_.preprocess_ms += time.ms();
+      return;
+    }
+  }
+  // A pair needs a step: the previous frame stays until the sensor has moved far enough.
+  if (!paired || step.translation().norm() >= ElevationEstimate::kMinStep) {
+    elevation_previous_ = frame;
+    elevation_previous_pose_ = pose_;
+    elevation_previous_correction_ = corrected;
+  }
+  stats_.preprocess_ms += time.ms();
 }
 
 PointCloud OdometryPipeline::frame_detail(const PointCloud& frame,

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 
+#include "scanmatch/odometry/elevation_estimate.hpp"
 #include "scanmatch/odometry/frame_odometry.hpp"
 #include "scanmatch/odometry/motion_model.hpp"
 #include "scanmatch/odometry/preprocessor.hpp"
@@ -92,6 +93,9 @@ class OdometryPipeline : public FrameOdometry {
   /// The parts of a motion (log) that anchor the world: those of the first measured motion above
   /// anchor_min_*.
   Vector6d anchored_part(const Vector6d& motion) const;
+  /// Offers the pair of the last registered frame and `frame` (preprocessed, at pose_) to the
+  /// elevation estimate; once it decides, later frames are preprocessed with its correction.
+  void offer_elevation_pair(const PointCloud& frame);
   /// `frame` cropped, deskewed by `motion` (when given) and filtered at map density.
   PointCloud frame_detail(const PointCloud& frame, const FrameMotion* motion) const;
 
@@ -112,6 +116,11 @@ class OdometryPipeline : public FrameOdometry {
   /// Frame-start poses of the frames before the world settles, in the internal frame.
   std::array<Pose, kWorldSettlesAfter> early_starts_{};
   FrameStats stats_;
+  bool estimating_elevation_;
+  ElevationEstimate elevation_;
+  PointCloud elevation_previous_;  ///< the last frame offered, until the estimate decides
+  Pose elevation_previous_pose_ = Pose::Identity();
+  double elevation_previous_correction_ = 0.0;  ///< rad, what it was preprocessed with
 };
 
 }  // namespace scanmatch

@@ -59,6 +59,8 @@ class Preprocessor {
   /// The frame cropped and deskewed as by process, filtered at voxel_size / 4 (map density).
   PointCloud map_detail(const PointCloud& frame, const FrameMotion* motion = nullptr) const;
   const PreprocessOptions& options() const { return options_; }
+  /// rad: every later frame's elevations lowered by this (PreprocessOptions::elevation_correction).
+  void set_elevation_correction(double angle) { options_.elevation_correction = angle; }
 
  private:
   PointCloud crop_and_deskew(const PointCloud& frame, const FrameMotion* motion) const;

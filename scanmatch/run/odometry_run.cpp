@@ -88,12 +88,15 @@ nlohmann::ordered_json health_json(const std::vector<FrameStats>& frames) {
     if (f.fine_paired_fraction > 0.0) paired.push_back(f.fine_paired_fraction);
   }
   std::sort(paired.begin(), paired.end());
-  return {{"uncertain_priors", uncertain},
-          {"recoveries", recovered},
-          {"global_starts", global_starts},
-          {"thin_map_frames", thin},
-          {"coarse_fine_disagreements", disagreeing},
-          {"median_fine_paired_fraction", paired.empty() ? 0.0 : paired[paired.size() / 2]}};
+  return {
+      {"uncertain_priors", uncertain},
+      {"recoveries", recovered},
+      {"global_starts", global_starts},
+      {"thin_map_frames", thin},
+      {"coarse_fine_disagreements", disagreeing},
+      {"median_fine_paired_fraction", paired.empty() ? 0.0 : paired[paired.size() / 2]},
+      // The beam elevation correction the run ended with (elevation_estimate's decision).
+      {"elevation_correction_deg", frames.empty() ? 0.0 : frames.back().elevation_correction_deg}};
 }
 
 // The keys of `scanmatch eval --json`.
