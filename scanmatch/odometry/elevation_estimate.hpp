@@ -1,11 +1,11 @@
 #pragma once
 // A spinning sensor's beam elevation bias, estimated from the run's first moving frame pairs
 // (geometry/beam_elevation.hpp): riverside02_keyframes' OS1-64 reads about 0.2 deg high, and
-// ctf-icp then pitches 0.07 deg a keyframe (docs/odometry.md, "Beam elevation"). The correction
-// follows the pairs' median while that is clear, and settles after at most kMaxPairs pairs. Clear
-// means well above the estimator's own error on exact simulated scans (campus-os1's OS1-64: -0.06
-// deg; dynamic-outdoor-fast seed 2's Mid-360: -0.14, from the shapes of the scene), so that data
-// without a bias is left as delivered.
+// ctf-icp then pitches 0.07 deg a keyframe (docs/odometry.md, "Beam elevation, estimated"). The
+// correction follows the pairs' median while that is clear, and settles after at most kMaxPairs
+// pairs. Clear means well above the estimator's own error on exact simulated scans (campus-os1's
+// OS1-64: -0.06 deg; dynamic-outdoor-fast seed 2's Mid-360: -0.14, from the shapes of the scene),
+// so that data without a bias is left as delivered.
 
 #include <cstddef>
 #include <vector>
