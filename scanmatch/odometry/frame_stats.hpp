@@ -39,7 +39,8 @@ struct FrameStats {
 template <typename Stats, typename Visitor>
 requires std::same_as<std::remove_const_t<Stats>, FrameStats>
 void describe(Stats& s, Visitor& v) {
-  v.stage("preprocess_ms", s.preprocess_ms, "preprocess", "crops, voxel filter and deskew, ms");
+  v.stage("preprocess_ms", s.preprocess_ms, "preprocess",
+          "crops, voxel filter and deskew (and the beam elevation estimate's pairs), ms");
   v.stage("coarse_ms", s.coarse_ms, "coarse",
           "ctf-icp's coarse NDT stage, or the frame-to-frame registration, ms");
   v.stage("fine_ms", s.fine_ms, "fine", "ctf-icp's fine stage (frame to map), ms");
