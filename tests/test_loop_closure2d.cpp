@@ -122,6 +122,23 @@ TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
   close(sparse);
   EXPECT_LT(sparse.counts().candidates, c.candidates);
   EXPECT_LT(absolute_trajectory_error_2d(reference, sparse.poses()).rmse, 0.5 * before.rmse);
+  // Place-database matches beyond the estimate gate's reach are not verified: verified, none of
+  // them is added, so the same loops come out of fewer verifications.
+  LoopClosure2DOptions all_verified;
+  all_verified.registration_reach = -1.0;
+  LoopClosure2D unfiltered(all_verified);
+  close(unfiltered);
+  EXPECT_GT(c.ruled_out_by_estimate, 0u);
+  EXPECT_EQ(unfiltered.counts().ruled_out_by_estimate, 0u);
+  EXPECT_EQ(unfiltered.counts().candidates, c.candidates + c.ruled_out_by_estimate);
+  ASSERT_EQ(unfiltered.loops().size(), loops.loops().size());
+  for (std::size_t i = 0; i < loops.loops().size(); ++i) {
+    EXPECT_EQ(unfiltered.loops()[i].from_keyframe, loops.loops()[i].from_keyframe);
+    EXPECT_EQ(unfiltered.loops()[i].to_keyframe, loops.loops()[i].to_keyframe);
+  }
+  const std::vector<Pose2> all = unfiltered.poses();
+  for (std::size_t i = 0; i < all.size(); ++i)
+    EXPECT_TRUE(all[i].matrix() == optimized[i].matrix()) << "scan " << i;
 }
 
 TEST(LoopClosure2D, ASubmapVerifiesWhatTwoHalfViewsCannot) {
@@ -522,6 +539,7 @@ TEST(LoopClosure2D, OptionsOutOfRangeAreRefused) {
   refused([](LoopClosure2DOptions& o) { o.verification.min_search_score = 1.2; });
   refused([](LoopClosure2DOptions& o) { o.optimize_above = -0.1; });
   refused([](LoopClosure2DOptions& o) { o.recheck_above = std::nan(""); });
+  refused([](LoopClosure2DOptions& o) { o.registration_reach = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.odometry_spread_margin = -0.01; });
   refused([](LoopClosure2DOptions& o) { o.odometry_spread_window = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.rotation_open_ratio = -0.1; });

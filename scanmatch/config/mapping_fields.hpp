@@ -199,6 +199,8 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
     "A verified loop may move the estimate by this many m ...");
   v("max_correction_per_m", o.max_correction_per_m, nullptr,
     "... plus this share of the path between the two keyframes");
+  v("registration_reach", o.registration_reach, nullptr,
+    "How far verification can move a place-database match, m (negative: all are verified)");
   v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
   v("keyframes_between_loops", o.keyframes_between_loops, nullptr,
     "Keyframes without a search after one that added a loop");

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -50,6 +51,8 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
         "rotation_open_sigma_theta must be positive");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
+  if (std::isnan(options.registration_reach))
+    throw Error("loop closure: registration_reach must be a number (negative: off)");
   if (!(options.recheck_above >= 0.0))
     throw Error("loop closure: recheck_above must not be negative");
   if (!(options.verification.min_search_score >= 0.0 &&
@@ -137,8 +140,21 @@ void LoopClosure2D::close_loops(std::size_t keyframe) {
 }
 
 bool LoopClosure2D::search_loops(std::size_t keyframe) {
-  const LoopCandidates found =
-      find_loop_candidates(keyframe, options_.skip_recent, graph(), places_, options_.candidates);
+  // A database match beyond the gate's reach is ruled out, unless a rotation-open step between
+  // the two keyframes lets the gate turn the newer ones (agrees_turned_at_open_rotation).
+  LoopCandidateReach reach;
+  if (options_.registration_reach >= 0.0)
+    reach = [&](std::size_t k) {
+      const bool turnable =
+          std::any_of(keyframes_.begin() + static_cast<std::ptrdiff_t>(k) + 1,
+                      keyframes_.begin() + static_cast<std::ptrdiff_t>(keyframe) + 1,
+                      [](const Keyframe& f) { return f.rotation_open; });
+      return turnable ? std::numeric_limits<double>::infinity()
+                      : correction_allowed(k, keyframe) + options_.registration_reach;
+    };
+  const LoopCandidates found = find_loop_candidates(keyframe, options_.skip_recent, graph(),
+                                                    places_, options_.candidates, 0, reach);
+  counts_.ruled_out_by_estimate += found.ruled_out;
   const Pose2& here = graph().pose(keyframe);
   bool stale = false;
   std::optional<LoopCurrent2D> current;  // for all of the keyframe's candidates
@@ -166,9 +182,7 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
       ++counts_.rejected_by_verification;
       continue;
     }
-    const double allowed =
-        options_.max_correction +
-        options_.max_correction_per_m * (keyframes_[keyframe].path - keyframes_[k].path);
+    const double allowed = correction_allowed(k, keyframe);
     if ((estimated.translation() - v.transform.translation()).norm() > allowed) {
       if (!agrees_turned_at_open_rotation(k, keyframe, graph().pose(k) * v.transform, allowed)) {
         ++counts_.rejected_by_estimate;
@@ -224,6 +238,11 @@ const LoopReference2D& LoopClosure2D::prepared_reference(std::size_t keyframe,
   if (prepared_.size() >= kPreparedReferences) prepared_.erase(prepared_.begin());
   prepared_.push_back(std::move(wanted));
   return *prepared_.back().reference;
+}
+
+double LoopClosure2D::correction_allowed(std::size_t older, std::size_t newer) const {
+  return options_.max_correction +
+         options_.max_correction_per_m * (keyframes_[newer].path - keyframes_[older].path);
 }
 
 bool LoopClosure2D::agrees_turned_at_open_rotation(std::size_t older, std::size_t newer,

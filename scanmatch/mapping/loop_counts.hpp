@@ -41,6 +41,8 @@ void describe(Counts& c, Visitor& v) {
   v("turned_at_open_rotation", c.turned_at_open_rotation,
     "verified loops the estimate check let through only by turning the keyframes after a "
     "rotation-open step");
+  v("ruled_out_by_estimate", c.ruled_out_by_estimate,
+    "place-database matches ruled out before verification (registration_reach); not candidates");
   v("total_ms", c.total_ms, "wall time spent in add_scan() and finish(), ms");
 }
 

@@ -103,14 +103,16 @@ class RangeProfile {
     for (const Eigen::Vector2d& p : points) {
       double& r = ranges_[bin(p)];
       r = std::max(r, p.norm());
+      farthest_ = std::max(farthest_, r);
     }
   }
   /// True when `p` (in this scan's frame) lies more than `margin` in front of the returns seen
   /// on both sides of its bearing (the nearest within kMaxGap bins each way, so that a beam
   /// spacing coarser than a bin does not hide the free space and an edge does not count).
   bool in_free_space(const Eigen::Vector2d& p, double margin) const {
-    const std::size_t b = bin(p);
     const double r = p.norm() + margin;
+    if (!(r < farthest_)) return false;  // no return lies beyond it: spares the bearing
+    const std::size_t b = bin(p);
     const double before = nearest_seen(b, kBins - 1), after = nearest_seen((b + 1) % kBins, 1);
     return before > r && after > r;
   }
@@ -129,6 +131,7 @@ class RangeProfile {
     return -1.0;
   }
   std::vector<double> ranges_;
+  double farthest_ = -1.0;  // the farthest return of all
 };
 
 struct OverlapCheck {
