@@ -113,8 +113,8 @@ struct LoopClosure2DOptions {
   double max_correction_per_m = 0.05;
   /// How far (m) verification can move a place-database match from its start (no translation):
   /// a match farther than the gate above plus this from the new keyframe in the estimate is
-  /// ruled out without being verified (verified, the gate would reject it), unless a
-  /// rotation-open step between the two keyframes lets the gate turn the newer ones. The search
+  /// ruled out without being verified (verified, the gate would reject it but for a slide), unless
+  /// a rotation-open step between the two keyframes lets the gate turn the newer ones. The search
   /// window's corner is 2.8 m away, but a sliding match is fitted again at the estimate's
   /// position along its corridor: on ACES such loops came from matches up to 6.6 m beyond the
   /// gate. With 7 m every loop on the six CARMEN logs and room-2d stays as it was, and 9-25 % of
