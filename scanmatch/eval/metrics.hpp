@@ -9,13 +9,10 @@
 
 #include "scanmatch/core/alignment.hpp"
 #include "scanmatch/core/se3.hpp"
+#include "scanmatch/core/statistics.hpp"
 #include "scanmatch/io/trajectory.hpp"
 
 namespace scanmatch {
-
-/// Median (the mean of the two middle values for an even count) and mean; 0 for no values.
-double median_of(std::vector<double> values);
-double mean_of(const std::vector<double>& values);
 
 enum class Alignment { kNone, kSe3, kSim3 };
 Alignment parse_alignment(const std::string& name);  ///< "none", "se3", "sim3"; throws Error

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "scanmatch/core/statistics.hpp"
+
 namespace scanmatch {
 namespace {
 
@@ -14,17 +16,10 @@ constexpr double kSettledError = 0.02 * kRadiansPerDegree;
 constexpr double kMinCorrection = 0.15 * kRadiansPerDegree;
 constexpr double kSignificance = 4.0;
 
-double median_of(std::vector<double> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  if (values.size() % 2 == 1) return *middle;
-  return 0.5 * (*middle + *std::max_element(values.begin(), middle));
-}
-
 }  // namespace
 
 double ElevationEstimate::median() const {
-  return biases_.empty() ? 0.0 : median_of(biases_);
+  return median_of(biases_);
 }
 
 double ElevationEstimate::median_error() const {
