@@ -1,6 +1,7 @@
 #include "scanmatch/odometry/odometry_pipeline.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "scanmatch/core/error.hpp"
@@ -13,12 +14,8 @@ namespace {
 /// step is within this many of frame 0's sweeps.
 constexpr double kContiguousSweeps = 1.5;
 
-/// Under constant acceleration, the motion per frame over frame 0's first half (its value at the
-/// first quarter), from the first two mid-to-mid motions v1 and v2 (the rates at frames 1 and 2's
-/// starts): v1 - 0.75 (v2 - v1).
-Vector6d first_half_rate(const Vector6d& v1, const Vector6d& v2) {
-  return 1.75 * v1 - 0.75 * v2;
-}
+/// The early motions along the way lie on a line where its slope is this many standard errors.
+constexpr double kLineSignificance = 5.0;
 
 }  // namespace
 
@@ -102,27 +99,20 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   if (timed_frames_ && frames_ > 0) {
     const Pose& velocity = motion_.velocity();
     reported = pose_ * se3_exp(-0.5 * se3_log(velocity));
-    // The world is frame 0's start pose: half of frame 0's motion before its mid-frame pose (the
-    // internal origin). Frame 1 takes the first measured motion (mid-frame 0 to 1) for it; frame 2
-    // extrapolates the rate back to frame 0's first half (first_half_rate; a hand-held turn slows
-    // from 25 to 16.5 deg per frame), and the runner reports frame 1 again under that
-    // (settled_pose). The extrapolation doubles the registrations' noise, so only where it can
-    // pay: where frames follow one another (kContiguousSweeps: across keyframes 0.5 s apart a car
-    // speeding up is no constant acceleration, campus-os1 every 5th frame 0.29 -> 1.85 %), for a
-    // registration trusted to deskew again (gicp 0.255 -> 0.290 %), and where the motion changed
-    // by more than the dead band. Only the parts of the motion above anchor_min_* anchor the world
-    // at all (a still start's noise or a robot's jitter would turn every later pose).
-    if (frames_ == 1) {
-      first_velocity_ = se3_log(velocity);
-      world_from_internal_ = se3_exp(0.5 * anchored_part(first_velocity_));
-    }
-    if (frames_ == 2 && deskews_again_ && !stats_.bridged &&
-        motion_.frame_period() <= kContiguousSweeps * first_sweep_ &&
-        motion_.moving(se3_exp(first_velocity_).inverse() * velocity))
-      world_from_internal_ =
-          se3_exp(0.5 * anchored_part(first_half_rate(first_velocity_, se3_log(velocity))));
+    if (frames_ == 1) first_velocity_ = se3_log(velocity);
   }
-  if (frames_ < kWorldSettlesAfter) early_starts_[frames_] = reported;
+  if (frames_ < kWorldSettlesAfter) {
+    early_starts_[frames_] = reported;
+    if (timed_frames_ && frames_ > 0) {
+      early_middles_[frames_] = pose_;
+      early_velocities_[frames_] = se3_log(motion_.velocity());
+      if (early_fitted_ + 1 == frames_ && deskews_again_ && !stats_.bridged &&
+          motion_.frame_period() <= kContiguousSweeps * first_sweep_)
+        early_fitted_ = frames_;
+      settle_early_frames();
+      reported = early_starts_[frames_];
+    }
+  }
   reported = world_from_internal_ * reported;
   if (estimating_elevation_) offer_elevation_pair(down);
   update_reference(std::move(down), map_points_, pose_, stats_.bridged, stats_);
@@ -220,6 +210,65 @@ void OdometryPipeline::offer_elevation_pair(const PointCloud& frame) {
 PointCloud OdometryPipeline::frame_detail(const PointCloud& frame,
                                           const FrameMotion* motion) const {
   return preprocessor_.map_detail(frame, motion);
+}
+
+void OdometryPipeline::settle_early_frames() {
+  // The world is frame 0's start pose: half of frame 0's first-half motion before its mid-frame
+  // pose (the internal origin). A frame reported as it comes starts half of its mid-to-mid motion
+  // (the rate at its start) before its middle; the early frames are reported again once the world
+  // settles, from what the frames after them measured:
+  // - frame 0's rate is v1 and v2's line taken back to a quarter into it (a hand-held turn slows
+  //   from 25 to 16.5 deg per frame), where the motion changed by more than the dead band;
+  // - along the way, where the motions v1..vk lie on a line (kLineSignificance: a vehicle speeding
+  //   up, not a hand-held sensor's bounce or a car's sway), frame 0's rate and every early frame's
+  //   first-half rate come from that line. Speeding up by a per frame^2, a frame's start lies a/8
+  //   behind where its mid-to-mid motion puts it: urban-hdl64 starts at 8 m/s^2 and frame 1 came
+  //   out 10 mm ahead of frame 0; the line also passes the first registration's error on 1.15 times
+  //   where two motions passed it 1.5 times.
+  // Only where frames follow one another (kContiguousSweeps: across keyframes 0.5 s apart a car
+  // speeding up is no constant acceleration, campus-os1 every 5th frame 0.29 -> 1.85 %), for a
+  // registration trusted to deskew again (gicp 0.255 -> 0.290 %). Only the parts of the motion
+  // above anchor_min_* anchor the world at all (a still start's noise or a robot's jitter would
+  // turn every later pose).
+  const std::size_t k = early_fitted_;
+  Vector6d first_rate = first_velocity_;
+  std::array<Vector6d, kWorldSettlesAfter> rates = early_velocities_;
+  const Vector6d& v1 = early_velocities_[1];
+  const Vector6d& v2 = early_velocities_[2];
+  if (k >= 2 && motion_.moving(se3_exp(v1).inverse() * se3_exp(v2)))
+    first_rate = 1.75 * v1 - 0.75 * v2;
+  if (k >= 3) {
+    // Along the way: a straight line through the motions v1..vk, least squares.
+    Eigen::Vector3d way = Eigen::Vector3d::Zero();
+    for (std::size_t i = 1; i <= k; ++i) way += early_velocities_[i].tail<3>();
+    if (way.norm() > 0.0) way.normalize();
+    const double middle = 0.5 * static_cast<double>(k + 1);
+    double mean = 0.0, slope = 0.0, spread = 0.0;
+    for (std::size_t i = 1; i <= k; ++i) {
+      const double t = static_cast<double>(i) - middle,
+                   along = way.dot(early_velocities_[i].tail<3>());
+      mean += along / static_cast<double>(k);
+      slope += t * along;
+      spread += t * t;
+    }
+    slope /= spread;
+    double residuals = 0.0;
+    for (std::size_t i = 1; i <= k; ++i) {
+      const double t = static_cast<double>(i) - middle;
+      residuals += std::pow(way.dot(early_velocities_[i].tail<3>()) - mean - t * slope, 2);
+    }
+    const double deviation = std::sqrt(residuals / static_cast<double>(k - 2));
+    const bool on_a_line = std::abs(slope) * std::sqrt(spread) >= kLineSignificance * deviation;
+    if (on_a_line &&
+        std::abs(slope) * static_cast<double>(k - 1) >= config_.deskew_min_translation) {
+      const double along_start = mean + (0.25 - middle) * slope;  // a quarter into frame 0
+      first_rate.tail<3>() += (along_start - way.dot(first_rate.tail<3>())) * way;
+      for (std::size_t i = 1; i <= k; ++i) rates[i].tail<3>() += 0.25 * slope * way;
+    }
+  }
+  world_from_internal_ = se3_exp(0.5 * anchored_part(first_rate));
+  for (std::size_t i = 1; i <= frames_; ++i)
+    early_starts_[i] = early_middles_[i] * se3_exp(-0.5 * rates[i]);
 }
 
 Vector6d OdometryPipeline::anchored_part(const Vector6d& motion) const {

@@ -27,7 +27,7 @@ class OdometryPipeline : public FrameOdometry {
   const FrameStats& last_stats() const final { return stats_; }
   const PointCloud* last_map_frame(Pose& registration_from_frame) const final;
   Pose world_from_registration() const final { return world_from_internal_; }
-  /// The world anchor is set at frame 1 and refined at frame 2.
+  /// The world anchor is set at frame 1 and refined up to frame 4 (settle_early_frames).
   std::size_t world_settles_after() const final { return kWorldSettlesAfter; }
   Pose settled_pose(std::size_t index) const final;
   const PointCloud* settled_first_frame() const final {
@@ -88,11 +88,13 @@ class OdometryPipeline : public FrameOdometry {
   Pose deskew_again(const PointCloud& frame, const MotionPrior& prior, bool deskewed,
                     const Pose& estimate, PointCloud& down);
 
-  static constexpr std::size_t kWorldSettlesAfter = 3;
+  static constexpr std::size_t kWorldSettlesAfter = 5;
 
   /// The parts of a motion (log) that anchor the world: those of the first measured motion above
   /// anchor_min_*.
   Vector6d anchored_part(const Vector6d& motion) const;
+  /// The world anchor and the early frames' start poses from the motions measured so far.
+  void settle_early_frames();
   /// Offers the pair of the last registered frame and `frame` (preprocessed, at pose_) to the
   /// elevation estimate; once it decides, later frames are preprocessed with its correction.
   void offer_elevation_pair(const PointCloud& frame);
@@ -115,6 +117,11 @@ class OdometryPipeline : public FrameOdometry {
   PointCloud settled_first_frame_;  ///< frame 0 deskewed at frame 1, until the world settles
   /// Frame-start poses of the frames before the world settles, in the internal frame.
   std::array<Pose, kWorldSettlesAfter> early_starts_{};
+  std::array<Pose, kWorldSettlesAfter> early_middles_{};  ///< their internal (mid-frame) poses
+  /// Logs of the early frames' measured motions (mid-frame i-1 to i, at index i).
+  std::array<Vector6d, kWorldSettlesAfter> early_velocities_{};
+  /// Early frames 1..this follow one another unbridged: their motions are fitted together.
+  std::size_t early_fitted_ = 0;
   FrameStats stats_;
   bool estimating_elevation_;
   ElevationEstimate elevation_;
