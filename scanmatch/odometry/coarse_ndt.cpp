@@ -79,10 +79,6 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
                            config_.coarse_voxel_size, config_.max_coarse_points)
           : PointCloud{};
   const PointCloud& source = sparser.empty() ? frame : sparser;
-  const bool try_starts = prior.uncertain && config_.uncertain_starts && !reference_.empty();
-  const std::vector<Pose> starts = try_starts ? distinct_starts(prior.motion) : std::vector<Pose>{};
-  const bool screen = try_starts && should_screen(starts.size(), source.size());
-
   // One factor on the normal grid for the plain solve, every start's refinement and the scores:
   // its voxel hints carry over between them.
   const NdtFactor normal = hinted_factor(source, grid_, config_);
@@ -94,6 +90,16 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   // A certain prior whose solve was slow to settle may have stopped in a ripple of the grid.
   const bool slow = !prior.uncertain && config_.wide_start_iterations > 0 &&
                     plain.iterations >= config_.wide_start_iterations && !reference_.empty();
+  const bool try_starts = (prior.uncertain || (slow && prior.turn_reach > 0.0)) &&
+                          config_.uncertain_starts && !reference_.empty();
+  int turned_per_side = config_.rotation_starts;
+  if (prior.turn_reach > 0.0 && config_.rotation_starts > 0 && config_.rotation_start_step > 0.0)
+    turned_per_side = std::max(
+        turned_per_side,
+        static_cast<int>(std::ceil(prior.turn_reach / config_.rotation_start_step - 1e-9)));
+  const std::vector<Pose> starts =
+      try_starts ? distinct_starts(prior.motion, turned_per_side) : std::vector<Pose>{};
+  const bool screen = try_starts && should_screen(starts.size(), source.size());
   KnownOptima optima;
   if (plain.converged) optima.poses.push_back(result.motion);
   std::vector<Pose> solved;
@@ -116,13 +122,13 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   return result;
 }
 
-std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion) const {
+std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion, int turned_per_side) const {
   std::vector<Pose> candidates = {prior_motion, Pose(Pose::Identity()),
                                   scaled_motion(prior_motion, 0.5),
                                   scaled_motion(prior_motion, 2.0)};
   // About the sensor's z axis: sensors are mounted upright, and hand-held ones sweep mostly about
   // the vertical. (The prior's own axis was tried: avia_hku1 1.5 % against 0.16 %.)
-  for (int k = 1; k <= config_.rotation_starts; ++k)
+  for (int k = 1; k <= turned_per_side; ++k)
     for (const double side : {-1.0, 1.0}) {
       Pose turned = prior_motion;
       turned.linear() =

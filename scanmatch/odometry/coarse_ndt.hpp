@@ -15,7 +15,8 @@
 // best few that beat the plain result on the subset are solved again on every point (most frames:
 // none). A certain prior whose solve took wide_start_iterations or more (slow: it may have stopped
 // in a ripple of the grid, as when a car enters a turn) gets the prior itself as the one other
-// start.
+// start; after a long time step (keyframes, MotionPrior::turn_reach) it gets every start, and the
+// turned starts reach as far as a vehicle turns in that time.
 
 #include <cstddef>
 #include <optional>
@@ -59,9 +60,9 @@ class CoarseNdt {
   const PointCloud& reference() const { return reference_; }
 
  private:
-  /// The other starts under an uncertain prior, `prior_motion` first, none within `near` of an
-  /// earlier one.
-  std::vector<Pose> distinct_starts(const Pose& prior_motion) const;
+  /// The other starts under an uncertain prior, `prior_motion` first, with `turned_per_side`
+  /// turned starts each way, none within `near` of an earlier one.
+  std::vector<Pose> distinct_starts(const Pose& prior_motion, int turned_per_side) const;
   /// Solves each start (on the wider grid first when `from_wide_grid`, then with `normal`, the
   /// coarse points' factor on the normal grid) and returns the optima not already in `optima`,
   /// adding them there; a solve that reaches a known optimum stops. Adds the iterations.

@@ -31,6 +31,11 @@ struct MotionPrior {
   /// The time step was more than max_step_ratio times the last one (a clamped scale): over such a
   /// gap the sensor may have stopped or slowed anywhere, so the gate spans the scaled motion.
   bool gap = false;
+  /// rad, set after a time step longer than a sweep (keyframes; 0 otherwise): between such frames
+  /// a vehicle turns farther than the coarse stage's basin (20 deg in 0.5 s at a corner), so a
+  /// slow solve under a certain prior also tries the other starts, and the turned ones reach this
+  /// far to either side.
+  double turn_reach = 0.0;
 };
 
 /// `motion` scaled along its own twist: factor 2 is the same motion twice (constant velocity).

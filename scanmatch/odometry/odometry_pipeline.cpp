@@ -14,6 +14,13 @@ namespace {
 /// step is within this many of frame 0's sweeps.
 constexpr double kContiguousSweeps = 1.5;
 
+/// s: the sweep of frames without point times (most spinning and Livox sensors run at 10 Hz).
+constexpr double kNominalSweep = 0.1;
+
+/// rad/s: how fast a vehicle may turn between keyframes (a car at a corner: 90 deg in 3 s), for
+/// the coarse stage's turned starts.
+constexpr double kTurnRate = 0.5;
+
 /// The early motions along the way lie on a line where its slope is this many standard errors.
 constexpr double kLineSignificance = 5.0;
 
@@ -43,11 +50,12 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
     timed_frames_ = frame.has_time();
     first_sweep_ = latest_point_time(frame);
   }
-  const MotionPrior& prior = motion_.predict(timestamp, frames_);
+  MotionPrior prior = motion_.predict(timestamp, frames_);
+  if (frames_ > 1 && long_time_step()) prior.turn_reach = turn_reach();
   // Deskew once a velocity is measured, and only above the dead band: deskewing by a velocity that
   // is itself estimation noise feeds that noise back into the next pose.
   const bool deskew = config_.deskew && frames_ > 1 && motion_.moving(motion_.velocity());
-  const FrameMotion frame_motion{prior.motion, motion_.frame_period()};
+  const FrameMotion frame_motion = over_time_step(prior.motion);
   PointCloud down = preprocessor_.process(frame, deskew ? &frame_motion : nullptr,
                                           wants_map_points_ ? &map_points_ : nullptr);
   if (frames_ == 0 && deskews_again_) set_first_frame_detail(frame_detail(frame, nullptr));
@@ -98,7 +106,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
   Pose reported = pose_;
   if (timed_frames_ && frames_ > 0) {
     const Pose& velocity = motion_.velocity();
-    reported = pose_ * se3_exp(-0.5 * se3_log(velocity));
+    reported = pose_ * se3_exp(-middle_share() * se3_log(velocity));
     if (frames_ == 1) first_velocity_ = se3_log(velocity);
   }
   if (frames_ < kWorldSettlesAfter) {
@@ -106,6 +114,7 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
     if (timed_frames_ && frames_ > 0) {
       early_middles_[frames_] = pose_;
       early_velocities_[frames_] = se3_log(motion_.velocity());
+      early_middle_shares_[frames_] = middle_share();
       if (early_fitted_ + 1 == frames_ && deskews_again_ && !stats_.bridged &&
           motion_.frame_period() <= kContiguousSweeps * first_sweep_)
         early_fitted_ = frames_;
@@ -131,7 +140,7 @@ Pose OdometryPipeline::deskew_again(const PointCloud& frame, const MotionPrior& 
                       rotation_angle(miss) > config_.redeskew_rotation;
   if (!first_motion && !missed) return estimate;
   const Stopwatch preprocess_time;
-  const FrameMotion frame_motion{measured, motion_.frame_period()};
+  const FrameMotion frame_motion = over_time_step(measured);
   if (first_motion) {
     PointCloud first_map_points;
     PointCloud first = preprocessor_.process(first_frame_, &frame_motion,
@@ -266,9 +275,30 @@ void OdometryPipeline::settle_early_frames() {
       for (std::size_t i = 1; i <= k; ++i) rates[i].tail<3>() += 0.25 * slope * way;
     }
   }
-  world_from_internal_ = se3_exp(0.5 * anchored_part(first_rate));
+  world_from_internal_ = se3_exp(early_middle_shares_[1] * anchored_part(first_rate));
   for (std::size_t i = 1; i <= frames_; ++i)
-    early_starts_[i] = early_middles_[i] * se3_exp(-0.5 * rates[i]);
+    early_starts_[i] = early_middles_[i] * se3_exp(-early_middle_shares_[i] * rates[i]);
+}
+
+bool OdometryPipeline::long_time_step() const {
+  const double sweep = first_sweep_ > 0.0 ? first_sweep_ : kNominalSweep;
+  return motion_.frame_period() > kContiguousSweeps * sweep;
+}
+
+double OdometryPipeline::turn_reach() const {
+  return std::max(2.0 * config_.rotation_starts * config_.rotation_start_step,
+                  kTurnRate * motion_.frame_period());
+}
+
+double OdometryPipeline::middle_share() const {
+  const double step = motion_.frame_period();
+  if (step <= kContiguousSweeps * first_sweep_ || step <= 0.0) return 0.5;
+  return 0.5 * first_sweep_ / step;
+}
+
+FrameMotion OdometryPipeline::over_time_step(const Pose& motion) const {
+  const double step = motion_.frame_period();
+  return FrameMotion{motion, step, middle_share() * step};
 }
 
 Vector6d OdometryPipeline::anchored_part(const Vector6d& motion) const {

@@ -113,7 +113,7 @@ PointCloud Preprocessor::crop_and_deskew(const PointCloud& frame, const FrameMot
                max2 = options_.max_range * options_.max_range;
   const bool deskew = motion != nullptr && frame.has_time();
   std::optional<Deskew> deskewing;
-  if (deskew) deskewing.emplace(*motion, latest_point_time(frame), 0.5 * motion->period);
+  if (deskew) deskewing.emplace(*motion, latest_point_time(frame), motion->reference);
   const bool keep_ring = frame.has_ring() && options_.keep_attributes;
   const bool keep_intensity = frame.has_intensity() && options_.keep_attributes;
   const bool corrected = options_.elevation_correction != 0.0;

@@ -20,10 +20,12 @@
 
 namespace scanmatch {
 
-/// The sensor's motion over one frame, assumed constant: `motion` over `period` s.
+/// The sensor's motion over one frame, assumed constant: `motion` over `period` s; points are
+/// moved to the sensor pose `reference` s after the frame's start.
 struct FrameMotion {
   Pose motion = Pose::Identity();
   double period = 0.1;
+  double reference = 0.05;
 };
 
 struct PreprocessOptions {
