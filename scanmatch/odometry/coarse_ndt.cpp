@@ -98,7 +98,8 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
         turned_per_side,
         static_cast<int>(std::ceil(prior.turn_reach / config_.rotation_start_step - 1e-9)));
   const std::vector<Pose> starts =
-      try_starts ? distinct_starts(prior.motion, turned_per_side) : std::vector<Pose>{};
+      try_starts ? distinct_starts(prior.motion, turned_per_side, prior.turn_reach > 0.0)
+                 : std::vector<Pose>{};
   const bool screen = try_starts && should_screen(starts.size(), source.size());
   KnownOptima optima;
   if (plain.converged) optima.poses.push_back(result.motion);
@@ -122,7 +123,8 @@ CoarseResult CoarseNdt::align(const PointCloud& frame, const MotionPrior& prior)
   return result;
 }
 
-std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion, int turned_per_side) const {
+std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion, int turned_per_side,
+                                             bool along_arc) const {
   std::vector<Pose> candidates = {prior_motion, Pose(Pose::Identity()),
                                   scaled_motion(prior_motion, 0.5),
                                   scaled_motion(prior_motion, 2.0)};
@@ -130,12 +132,12 @@ std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion, int turne
   // the vertical. (The prior's own axis was tried: avia_hku1 1.5 % against 0.16 %.)
   for (int k = 1; k <= turned_per_side; ++k)
     for (const double side : {-1.0, 1.0}) {
+      const double angle = side * k * config_.rotation_start_step;
       Pose turned = prior_motion;
-      turned.linear() =
-          prior_motion.linear() *
-          Eigen::AngleAxisd(side * k * config_.rotation_start_step, Eigen::Vector3d::UnitZ())
-              .toRotationMatrix();
+      turned.linear() = prior_motion.linear() *
+                        Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       candidates.push_back(turned);
+      if (along_arc) candidates.push_back(along_an_arc(prior_motion, angle));
     }
   std::vector<Pose> starts;
   for (const Pose& start : candidates) {

@@ -61,8 +61,10 @@ class CoarseNdt {
 
  private:
   /// The other starts under an uncertain prior, `prior_motion` first, with `turned_per_side`
-  /// turned starts each way, none within `near` of an earlier one.
-  std::vector<Pose> distinct_starts(const Pose& prior_motion, int turned_per_side) const;
+  /// turned starts each way (each also bent along an arc where `along_arc`), none within `near`
+  /// of an earlier one.
+  std::vector<Pose> distinct_starts(const Pose& prior_motion, int turned_per_side,
+                                    bool along_arc) const;
   /// Solves each start (on the wider grid first when `from_wide_grid`, then with `normal`, the
   /// coarse points' factor on the normal grid) and returns the optima not already in `optima`,
   /// adding them there; a solve that reaches a known optimum stops. Adds the iterations.

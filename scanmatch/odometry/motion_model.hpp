@@ -33,13 +33,19 @@ struct MotionPrior {
   bool gap = false;
   /// rad, set after a time step longer than a sweep (keyframes; 0 otherwise): between such frames
   /// a vehicle turns farther than the coarse stage's basin (20 deg in 0.5 s at a corner), so a
-  /// slow solve under a certain prior also tries the other starts, and the turned ones reach this
-  /// far to either side.
+  /// slow solve under a certain prior also tries the other starts, the turned ones reach this far
+  /// to either side and are also tried bent along an arc (along_an_arc), and the gate also lies
+  /// around the prior bent to the estimate's heading.
   double turn_reach = 0.0;
 };
 
 /// `motion` scaled along its own twist: factor 2 is the same motion twice (constant velocity).
 Pose scaled_motion(const Pose& motion, double factor);
+/// `motion` turned by `yaw` about the sensor's z axis at its end, its translation by half of it:
+/// the same path length bent along an arc, as a vehicle that turned `yaw` more on the way.
+Pose along_an_arc(const Pose& motion, double yaw);
+/// The rotation of `motion` about the sensor's z axis (rad).
+double yaw_of(const Pose& motion);
 
 class MotionModel {
  public:
@@ -47,6 +53,8 @@ class MotionModel {
 
   /// Starts the next frame, taken at `timestamp` s, after `frames` registered ones: its prior.
   const MotionPrior& predict(double timestamp, std::size_t frames);
+  /// Marks the frame just predicted as one after a long time step (MotionPrior::turn_reach).
+  void set_turn_reach(double reach) { prior_.turn_reach = reach; }
   /// The prior of the frame being registered.
   const MotionPrior& prior() const { return prior_; }
   /// The last measured motion between two frames (identity before the second frame).

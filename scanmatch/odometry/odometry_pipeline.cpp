@@ -50,8 +50,9 @@ Pose OdometryPipeline::register_frame(const PointCloud& frame, double timestamp)
     timed_frames_ = frame.has_time();
     first_sweep_ = latest_point_time(frame);
   }
-  MotionPrior prior = motion_.predict(timestamp, frames_);
-  if (frames_ > 1 && long_time_step()) prior.turn_reach = turn_reach();
+  motion_.predict(timestamp, frames_);
+  if (frames_ > 1 && long_time_step()) motion_.set_turn_reach(turn_reach());
+  const MotionPrior& prior = motion_.prior();
   // Deskew once a velocity is measured, and only above the dead band: deskewing by a velocity that
   // is itself estimation noise feeds that noise back into the next pose.
   const bool deskew = config_.deskew && frames_ > 1 && motion_.moving(motion_.velocity());
