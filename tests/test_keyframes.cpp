@@ -49,6 +49,16 @@ Keyframes simulate(sim::SimOptions options, const sim::KeyframeOptions& keyframe
   return k;
 }
 
+// Every `n`th of the first `frames` frames of `preset`, with point times.
+Keyframes every_nth(const std::string& preset, std::size_t frames, std::size_t n) {
+  sim::SimOptions o;
+  o.preset = preset;
+  o.frames = frames;
+  sim::KeyframeOptions every;
+  every.every = n;
+  return simulate(o, every);
+}
+
 AteResult track(const Keyframes& k, const OdometryConfig& config = {}) {
   Odometry odometry(config);
   std::vector<Pose> poses;
@@ -172,12 +182,7 @@ TEST(SimulatorKeyframes, TheCliWritesAKeyframeFolderThatOdometryTracksWithDefaul
 
 TEST(Keyframes, ASpinning64RingSensorEveryFifthFrameIsTracked) {
   // campus-os1 every 5th frame: 64 rings 0.5 s apart, the car 3 m from one to the next.
-  sim::SimOptions o;
-  o.preset = "campus-os1";
-  o.frames = sanitized() ? 50 : 150;
-  sim::KeyframeOptions every;
-  every.every = 5;
-  const Keyframes k = simulate(o, every);
+  const Keyframes k = every_nth("campus-os1", sanitized() ? 50 : 150, 5);
   const AteResult ate = track(k);
   // Measured 0.45 % of the 84 m (the first 30 keyframes, the car speeding up to 6 m/s; 0.29 %
   // before frame 1 was refined against frame 0 at map density, 1.25 % before each keyframe was
@@ -195,12 +200,7 @@ TEST(Keyframes, KeyframesWithPointTimesAreDeskewedWithinTheirOwnSweep) {
   // dynamic-outdoor-fast every 3rd frame: Mid-360 sweeps of 0.1 s, 0.3 s apart, with point times.
   // Each frame's points belong to its own 0.1 s; moved to the middle of the 0.3 s step instead,
   // every frame was shifted along an extrapolated motion.
-  sim::SimOptions o;
-  o.preset = "dynamic-outdoor-fast";
-  o.frames = sanitized() ? 90 : 300;
-  sim::KeyframeOptions every;
-  every.every = 3;
-  const Keyframes k = simulate(o, every);
+  const Keyframes k = every_nth("dynamic-outdoor-fast", sanitized() ? 90 : 300, 3);
   const AteResult ate = track(k);
   // Measured 0.062 % of the 30 m (0.275 % moved to the middle of the step).
   EXPECT_LT(ate.rmse_percent_of_path, 0.15);
@@ -229,12 +229,7 @@ TEST(Keyframes, ACarsKeyframesHalfASecondApartTurnThroughCorners) {
   // urban-hdl64 every 5th frame: the car turns up to 20 deg from one keyframe to the next, beyond
   // the coarse stage's basin (about 5 deg here), and a constant-velocity prior first misses each
   // turn and then carries it on into the straight after it.
-  sim::SimOptions o;
-  o.preset = "urban-hdl64";
-  o.frames = sanitized() ? 150 : 300;
-  sim::KeyframeOptions every;
-  every.every = 5;
-  const Keyframes k = simulate(o, every);
+  const Keyframes k = every_nth("urban-hdl64", sanitized() ? 150 : 300, 5);
   const std::vector<Pose> poses = tracked_poses(k);
   // Measured: worst step 2.0 deg (the first), 1.25 % of the path; 19-20 deg and 19.5 % before
   // the turned starts reached a keyframe's turn (one missed 20 deg turn after another).
