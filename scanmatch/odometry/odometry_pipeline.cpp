@@ -224,9 +224,9 @@ PointCloud OdometryPipeline::frame_detail(const PointCloud& frame,
 
 void OdometryPipeline::settle_early_frames() {
   // The world is frame 0's start pose: half of frame 0's first-half motion before its mid-frame
-  // pose (the internal origin). A frame reported as it comes starts half of its mid-to-mid motion
-  // (the rate at its start) before its middle; the early frames are reported again once the world
-  // settles, from what the frames after them measured:
+  // pose (the internal origin; a share of it for keyframes, middle_share()). A frame reported as it
+  // comes starts half of its mid-to-mid motion (the rate at its start) before its middle; the early
+  // frames are reported again once the world settles, from what the frames after them measured:
   // - frame 0's rate is v1 and v2's line taken back to a quarter into it (a hand-held turn slows
   //   from 25 to 16.5 deg per frame), where the motion changed by more than the dead band;
   // - along the way, where the motions v1..vk lie on a line (kLineSignificance: a vehicle speeding
