@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/io/carmen.hpp"
 #include "scanmatch/io/cloud_io.hpp"
@@ -156,6 +158,53 @@ TEST(Carmen, BadInputGivesClearErrors) {
   EXPECT_NE(err("ODOM 1 2 3\n").find("ODOM record has 4 fields"), std::string::npos);
   EXPECT_NE(err("PARAM a b\n").find("not a CARMEN log"), std::string::npos);
   EXPECT_NE(err("").find("not a CARMEN log"), std::string::npos);
+}
+
+TEST(Carmen, FlaserNoReturnReadingIsInferredFromTheLog) {
+  // FLASER records carry no maximum range: a reading the far end of the log repeats is the
+  // laser's "no return" (orebro logs 32.767 m), and readings from 2 cm below it are no returns.
+  const auto flaser = [](const std::vector<double>& ranges) {
+    std::ostringstream line;
+    line << "FLASER " << ranges.size();
+    for (double r : ranges) line << ' ' << r;
+    line << " 0 0 0 0 0 0 1 host 1\n";
+    return line.str();
+  };
+  std::string text, spread;
+  for (int scan = 0; scan < 20; ++scan) {
+    std::vector<double> ranges, plain;
+    for (int beam = 0; beam < 181; ++beam) {
+      const double range = 2.0 + 0.05 * beam + 0.01 * scan;
+      ranges.push_back(beam % 9 == 0 ? 32.767 : (beam % 9 == 1 ? 32.759 : range));
+      plain.push_back(range);
+    }
+    text += flaser(ranges);
+    spread += flaser(plain);
+  }
+  CarmenReadOptions inferring;
+  inferring.infer_no_return = true;
+  // Off by default: the scans keep 80 m.
+  EXPECT_FLOAT_EQ(parse_carmen_log(text, "no_return.log").scans[0].max_range, 80.0f);
+  const CarmenLog log = parse_carmen_log(text, "no_return.log", inferring);
+  ASSERT_EQ(log.scans.size(), 20u);
+  EXPECT_NEAR(log.scans[0].max_range, 32.747, 1e-4);
+  EXPECT_NEAR(*no_return_reading(log.scans), 32.747, 1e-4);
+  const Scan2D scan = scan_from_laser(log.scans[0]);
+  EXPECT_EQ(scan.points.size(), 181u - 41u);  // 21 beams log 32.767, 20 log 32.759
+  EXPECT_EQ(scan.misses.size(), 41u);
+  // Far readings that spread (a far wall) are returns: the default stands.
+  const CarmenLog plain = parse_carmen_log(spread, "plain.log", inferring);
+  EXPECT_FLOAT_EQ(plain.scans[0].max_range, 80.0f);
+  EXPECT_FALSE(no_return_reading(plain.scans));
+  // Too few readings to tell.
+  EXPECT_FALSE(no_return_reading({log.scans[0]}));
+  // ROBOTLASER1 records carry their own.
+  CarmenLog robot;
+  robot.scans = log.scans;
+  for (LaserScan2D& s : robot.scans) s.max_range = 40.0f;
+  const TempDir dir;
+  write_carmen_log(dir.file("robot.log"), robot, CarmenLaserRecord::kRobotLaser1);
+  EXPECT_FLOAT_EQ(read_carmen_log(dir.file("robot.log"), inferring).scans[0].max_range, 40.0f);
 }
 
 TEST(Carmen, RealLogsHaveTheDocumentedScanCounts) {

@@ -852,6 +852,111 @@ TEST(Map2D, LongSearchKeepsOrebrosCorridorSteps) {
   EXPECT_EQ(with_long, 0);
 }
 
+namespace {
+
+/// A simulated stretch of an open hall as a 1 Hz SICK log keeps it (FLASER: 181 beams over 180
+/// degrees, ranges in cm, "no return" logged as 51.15 m): pillars of 0.25 m radius 6 to 30 m
+/// from the path, no wall within the laser's 50 m, the robot driving about 1 m per scan with a
+/// few degrees of weave. Each scan's pose is its exact truth.
+std::vector<LaserScan2D> hall_scans(std::size_t count) {
+  std::vector<Vec2> pillars;
+  for (int i = 0; i < 80; ++i) {
+    // Spread deterministically over both sides of the path, 6 to 30 m off it.
+    const double along = -10.0 + 0.71 * i + 0.6 * std::sin(3.1 * i);
+    const double side = (i % 2 == 0 ? 1.0 : -1.0) * (6.0 + std::fmod(7.3 * i, 24.0));
+    pillars.emplace_back(along, side);
+  }
+  constexpr double kRadius = 0.3, kNoReturn = 51.15, kReach = 50.0;
+  std::vector<LaserScan2D> scans;
+  for (std::size_t k = 0; k < count; ++k) {
+    const double t = static_cast<double>(k);
+    const Pose2 pose = pose2(1.05 * t, 0.3 * std::sin(0.5 * t), 0.06 * std::sin(1.3 * t));
+    LaserScan2D scan;
+    scan.angle_min = -M_PI / 2;
+    scan.angle_increment = M_PI / 180;
+    scan.pose = Eigen::Vector3d(pose.translation().x(), pose.translation().y(), pose2_angle(pose));
+    scan.odom_pose = scan.pose;
+    scan.timestamp = t;
+    for (int beam = 0; beam < 181; ++beam) {
+      const double angle = pose2_angle(pose) + scan.angle_min + beam * scan.angle_increment;
+      const Vec2 d(std::cos(angle), std::sin(angle));
+      double range = kNoReturn;
+      for (const Vec2& c : pillars) {
+        // |o + r d - c| = radius, the nearer root.
+        const Vec2 oc = pose.translation() - c;
+        const double b = oc.dot(d), disc = b * b - (oc.squaredNorm() - kRadius * kRadius);
+        if (disc < 0.0) continue;
+        const double r = -b - std::sqrt(disc);
+        if (r > 0.1 && r < kReach) range = std::min(range, r);
+      }
+      // Logged in cm, as the Radish logs are.
+      scan.ranges.push_back(static_cast<float>(std::round(range * 100.0) / 100.0));
+    }
+    scans.push_back(std::move(scan));
+  }
+  return scans;
+}
+
+}  // namespace
+
+TEST(Map2D, OpenHallStepsHoldWhereNoReturnIsLoggedAsARange) {
+  // acapulco's open hall (scans 522-530: no return within 3 m, a third of the beams without any):
+  // FLASER records carry no maximum range, and read with 80 m the log's no-return reading (51.15
+  // m) became an arc of points about the sensor, which lines up with the previous scan's only
+  // where the robot did not move: nine steps of 0.9-1.2 m came out below 0.1 m. Read with the
+  // log's own no-return reading (CarmenReadOptions::infer_no_return), every step holds.
+  const scanmatch::testing::TempDir dir;
+  CarmenLog written;
+  written.scans = hall_scans(24);
+  write_carmen_log(dir.file("hall.log"), written, CarmenLaserRecord::kFlaser);
+  CarmenReadOptions inferring;
+  inferring.infer_no_return = true;
+  const CarmenLog read = read_carmen_log(dir.file("hall.log"), inferring);
+  ASSERT_EQ(read.scans.size(), 24u);
+  EXPECT_NEAR(read.scans.front().max_range, 51.13, 1e-4);
+  std::vector<LaserScan2D> as_returns = read.scans;
+  for (LaserScan2D& scan : as_returns) scan.max_range = 80.0f;  // the reading before
+  const Mapper2DConfig config;
+  const int off = off_steps(config, read.scans), off_as_returns = off_steps(config, as_returns);
+  std::printf("open hall: %d of 23 steps off, %d with no-return readings taken for returns\n", off,
+              off_as_returns);
+  EXPECT_EQ(off, 0);
+  EXPECT_GE(off_as_returns, 10);
+  // The command line's option reads the log the same way.
+  const auto odometry_ate = [&](const std::string& name, const std::string& option) {
+    const auto run = scanmatch::testing::run_cli("map2d " + dir.file("hall.log") + option +
+                                                 " --quiet --out " + dir.file(name));
+    EXPECT_EQ(run.status, 0) << run.output;
+    std::ifstream in(dir.file(name + "/summary.json"));
+    return nlohmann::json::parse(in)["ate_odometry"]["rmse_m"].get<double>();
+  };
+  const double with_option = odometry_ate("with", " --no-return-reading"),
+               without = odometry_ate("without", "");
+  std::printf("open hall, map2d odometry ATE: %.3f m with --no-return-reading, %.3f m without\n",
+              with_option, without);
+  EXPECT_LT(with_option, 0.3);  // measured 0.136 m; 7.27 m without
+  EXPECT_GT(without, 5.0 * with_option);
+}
+
+TEST(Map2D, AcapulcosOpenHallHoldsItsSteps) {
+  // acapulco scans 500-535: the robot enters the open hall at 522. With the log's no-return
+  // reading (51.13 m) taken for no return (`map2d --no-return-reading`) no step is off; taken for
+  // returns (80 m, the default), the steps into the hall stand still.
+  const std::string log =
+      scanmatch::testing::shared_data("data/2d/carmen/acapulco-corrected.log.gz");
+  if (log.empty()) GTEST_SKIP() << "../shared/data/2d/carmen is absent";
+  CarmenReadOptions inferring;
+  inferring.infer_no_return = true;
+  const CarmenLog read = read_carmen_log(log, inferring);
+  ASSERT_EQ(read.scans.size(), 861u);
+  EXPECT_NEAR(read.scans.front().max_range, 51.13, 1e-4);
+  std::vector<LaserScan2D> scans(read.scans.begin() + 500, read.scans.begin() + 536);
+  const Mapper2DConfig config;
+  EXPECT_EQ(off_steps(config, scans), 0);
+  for (LaserScan2D& scan : scans) scan.max_range = 80.0f;
+  EXPECT_GE(off_steps(config, scans), 3);
+}
+
 TEST(Map2D, MapperRefusesOptionsOutOfRangeBeforeTheFirstScan) {
   // Caught per scan, they would bridge every scan silently instead.
   const auto refused = [](auto change) {

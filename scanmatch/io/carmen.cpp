@@ -1,5 +1,6 @@
 #include "scanmatch/io/carmen.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "scanmatch/core/error.hpp"
@@ -52,12 +53,54 @@ class Fields {
 
 }  // namespace
 
+namespace {
+
+/// no_return_reading over the readings themselves (reordered).
+std::optional<double> no_return_in(std::vector<float>& readings) {
+  // The farthest 0.5 % of the readings, nearest first: enough of them to call one a code.
+  constexpr std::size_t kMinFar = 10;
+  const std::size_t far = readings.size() / 200;
+  if (far < kMinFar) return std::nullopt;
+  const auto first = readings.end() - static_cast<std::ptrdiff_t>(far);
+  std::nth_element(readings.begin(), first, readings.end());
+  std::sort(first, readings.end());
+  // The 2 cm that most of them fall within.
+  constexpr float kCluster = 0.02f;
+  std::size_t best = 0;
+  float best_low = 0.0f;
+  for (auto low = first, high = first; low != readings.end(); ++low) {
+    while (high != readings.end() && *high - *low <= kCluster) ++high;
+    const auto count = static_cast<std::size_t>(high - low);
+    if (count > best) {
+      best = count;
+      best_low = *low;
+    }
+  }
+  if (2 * best < far) return std::nullopt;
+  // The code may spread by a centimetre or two below that (51.14-51.16 m on acapulco).
+  return static_cast<double>(best_low) - static_cast<double>(kCluster);
+}
+
+void append_readings(const LaserScan2D& scan, std::vector<float>& readings) {
+  for (float r : scan.ranges)
+    if (std::isfinite(r) && r > 0.0f) readings.push_back(r);
+}
+
+}  // namespace
+
+std::optional<double> no_return_reading(const std::vector<LaserScan2D>& scans) {
+  std::vector<float> readings;
+  for (const LaserScan2D& scan : scans) append_readings(scan, readings);
+  return no_return_in(readings);
+}
+
 CarmenLog parse_carmen_log(std::string_view text, const std::string& source,
                            const CarmenReadOptions& options) {
   CarmenLog log;
   LineCursor cursor(text);
   std::string_view line;
   std::vector<std::string_view> tokens;
+  std::vector<std::size_t> flaser;  // the scans read from FLASER records
   while (cursor.next(line)) {
     const std::string_view content = trim(line);
     if (content.empty() || content.front() == '#') continue;
@@ -78,10 +121,12 @@ CarmenLog parse_carmen_log(std::string_view text, const std::string& source,
       scan.pose = Eigen::Vector3d(f.number(n + 2), f.number(n + 3), f.number(n + 4));
       scan.odom_pose = Eigen::Vector3d(f.number(n + 5), f.number(n + 6), f.number(n + 7));
       scan.timestamp = f.number(n + 10);
-      if (tokens[0] == "FLASER")
+      if (tokens[0] == "FLASER") {
+        flaser.push_back(log.scans.size());
         log.scans.push_back(std::move(scan));
-      else
+      } else {
         ++log.ignored_lines;  // rear laser
+      }
     } else if (tokens[0] == "ROBOTLASER1") {
       const std::size_t n = f.count(8);
       const std::size_t remissions = f.count(9 + n);
@@ -115,6 +160,15 @@ CarmenLog parse_carmen_log(std::string_view text, const std::string& source,
   }
   if (log.scans.empty() && log.odometry.empty())
     fail(source, "no FLASER, ROBOTLASER1 or ODOM records: not a CARMEN log");
+  // FLASER records carry no maximum range: the log's own no-return reading sets it where the
+  // readings show one below the default.
+  if (options.infer_no_return && !flaser.empty()) {
+    std::vector<float> readings;
+    for (std::size_t i : flaser) append_readings(log.scans[i], readings);
+    if (const std::optional<double> no_return = no_return_in(readings))
+      for (std::size_t i : flaser)
+        log.scans[i].max_range = std::min(log.scans[i].max_range, static_cast<float>(*no_return));
+  }
   return log;
 }
 

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,9 +20,11 @@ struct LaserScan2D {
   double timestamp = 0.0;               ///< logger timestamp, s
   double angle_min = -M_PI / 2;         ///< rad, angle of the first beam in the laser frame
   double angle_increment = M_PI / 180;  ///< rad between beams
-  float max_range = 80.0f;              ///< m; readings >= max_range or <= 0 are "no return"
-  std::vector<float> ranges;            ///< m
-  std::vector<float> remissions;        ///< optional
+  /// m; readings >= max_range or <= 0 are "no return" (FLASER: 80 or the log's no-return reading,
+  /// no_return_reading)
+  float max_range = 80.0f;
+  std::vector<float> ranges;                            ///< m
+  std::vector<float> remissions;                        ///< optional
   Eigen::Vector3d pose = Eigen::Vector3d::Zero();       ///< x, y, theta of the laser in the log
   Eigen::Vector3d odom_pose = Eigen::Vector3d::Zero();  ///< robot odometry x, y, theta
 };
@@ -50,7 +53,23 @@ struct CarmenReadOptions {
   /// FLASER records carry no angles: the laser's field of view, rad. Beams are spread over it as
   /// fov / (n - 1) for an odd count (181, 361) and fov / n for an even one (180, 360).
   double flaser_field_of_view = M_PI;
+  /// FLASER: lower every scan's max_range to the log's own no-return reading (no_return_reading)
+  /// where it shows one below 80 m. Off by default: on acapulco it mends the open hall (2.59 ->
+  /// 0.31 m loop-closed), but ACES's 50 m arcs hold its corridor steps today (0.105 -> 0.336 m
+  /// without them; docs/planar.md).
+  bool infer_no_return = false;
 };
+
+/// FLASER records carry no maximum range, and a laser reports "no return" as a reading of its
+/// own: 81.83 or 81.91 m on intel and freiburg-campus, but also 50.0 (aces), 51.05 (fhw),
+/// 51.15 (acapulco) or 32.767 m (orebro), which the default 80 m takes for returns: arcs of points
+/// about the sensor that line up with the previous scan's where the sensor did not move (acapulco's
+/// open hall came out standing still: docs/planar.md). Such a code is the reading the far end of
+/// a log repeats: where at least half of the farthest 0.5 % of `scans`' readings (10 at least)
+/// lie within 2 cm, readings from 2 cm below those count as no return, and that range is returned;
+/// else none. With CarmenReadOptions::infer_no_return, read_carmen_log and parse_carmen_log lower
+/// their FLASER scans' max_range to it.
+std::optional<double> no_return_reading(const std::vector<LaserScan2D>& scans);
 
 CarmenLog read_carmen_log(const std::string& path, const CarmenReadOptions& options = {});
 /// Parses log text; `source_name` names it in errors.

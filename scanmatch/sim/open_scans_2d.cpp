@@ -41,7 +41,9 @@ Scans2D load_scans_2d(const std::string& spec, const SequenceOptions& options,
     path = (fs::path(spec) / "scans.log").string();
     if (!fs::exists(path)) throw Error(spec + ": a folder without scans.log (not a 2D data set)");
   }
-  CarmenLog log = read_carmen_log(path);
+  CarmenReadOptions read_options;
+  read_options.infer_no_return = options.infer_no_return;
+  CarmenLog log = read_carmen_log(path, read_options);
   if (log.scans.empty()) throw Error(path + ": the log holds no laser scans");
   if (max_scans > 0 && log.scans.size() > max_scans) log.scans.resize(max_scans);
   out.scans = std::move(log.scans);

@@ -25,6 +25,9 @@ struct SequenceOptions {
   /// Its poses are re-expressed in the frame of its first pose, as the run's poses are.
   /// A KITTI file has no times, so the run writes no poses_gt_tum.txt for it.
   std::string reference;
+  /// 2D CARMEN logs: FLASER scans take the log's own no-return reading for their maximum range
+  /// (CarmenReadOptions::infer_no_return).
+  bool infer_no_return = false;
 };
 
 /// Opens `spec`:
