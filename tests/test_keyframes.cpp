@@ -229,7 +229,7 @@ TEST(Keyframes, ACarsKeyframesHalfASecondApartTurnThroughCorners) {
   // urban-hdl64 every 5th frame: the car turns up to 20 deg from one keyframe to the next, beyond
   // the coarse stage's basin (about 5 deg here), and a constant-velocity prior first misses each
   // turn and then carries it on into the straight after it.
-  const Keyframes k = every_nth("urban-hdl64", sanitized() ? 150 : 300, 5);
+  const Keyframes k = every_nth("urban-hdl64", sanitized() ? 100 : 300, 5);
   const std::vector<Pose> poses = tracked_poses(k);
   // Measured: worst step 2.0 deg (the first), 1.25 % of the path; 19-20 deg and 19.5 % before
   // the turned starts reached a keyframe's turn (one missed 20 deg turn after another).
@@ -240,14 +240,15 @@ TEST(Keyframes, ACarsKeyframesHalfASecondApartTurnThroughCorners) {
 TEST(Keyframes, ACarsKeyframesMetresApartTurnThroughCorners) {
   // campus-os1 keyframes 2-10 m apart (1-1.8 s, like riverside02_keyframes): at the first corner
   // the car turns 47 deg between keyframes 10 m apart and ends 4 m beside the straight prior.
+  if (sanitized()) GTEST_SKIP() << "400 OS1-64 frames: too slow under the sanitizers";
   sim::SimOptions o;
   o.preset = "campus-os1";
-  o.frames = sanitized() ? 350 : 400;
+  o.frames = 400;
   sim::KeyframeOptions apart;
   apart.distance = 2.0;
   apart.distance_max = 10.0;
   const Keyframes k = simulate(o, apart);
-  ASSERT_GT(k.frames.size(), sanitized() ? 30u : 35u);
+  ASSERT_GT(k.frames.size(), 35u);
   const std::vector<Pose> poses = tracked_poses(k);
   // Measured: worst step 0.96 deg, 0.12 % of the path; 48 deg and 5.9 % before the starts and
   // the gate followed an arc (the turned starts kept the straight prior's translation, and the
