@@ -51,10 +51,6 @@ class Fields {
   std::string where_;
 };
 
-}  // namespace
-
-namespace {
-
 /// no_return_reading over the readings themselves (reordered).
 std::optional<double> no_return_in(std::vector<float>& readings) {
   // The farthest 0.5 % of the readings, nearest first: enough of them to call one a code.

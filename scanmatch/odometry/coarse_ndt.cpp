@@ -133,10 +133,7 @@ std::vector<Pose> CoarseNdt::distinct_starts(const Pose& prior_motion, int turne
   for (int k = 1; k <= turned_per_side; ++k)
     for (const double side : {-1.0, 1.0}) {
       const double angle = side * k * config_.rotation_start_step;
-      Pose turned = prior_motion;
-      turned.linear() = prior_motion.linear() *
-                        Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      candidates.push_back(turned);
+      candidates.push_back(turned_about_z(prior_motion, angle));
       if (along_arc) candidates.push_back(along_an_arc(prior_motion, angle));
     }
   std::vector<Pose> starts;

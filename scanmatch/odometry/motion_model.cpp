@@ -22,17 +22,18 @@ Pose scaled_motion(const Pose& motion, double factor) {
   return se3_exp(factor * se3_log(motion));
 }
 
-Pose along_an_arc(const Pose& motion, double yaw) {
+Pose turned_about_z(const Pose& motion, double yaw) {
   Pose turned = motion;
   turned.linear() =
       motion.linear() * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  turned.translation() =
-      Eigen::AngleAxisd(0.5 * yaw, Eigen::Vector3d::UnitZ()) * motion.translation();
   return turned;
 }
 
-double yaw_of(const Pose& motion) {
-  return std::atan2(motion.linear()(1, 0), motion.linear()(0, 0));
+Pose along_an_arc(const Pose& motion, double yaw) {
+  Pose turned = turned_about_z(motion, yaw);
+  turned.translation() =
+      Eigen::AngleAxisd(0.5 * yaw, Eigen::Vector3d::UnitZ()) * motion.translation();
+  return turned;
 }
 
 MotionModel::MotionModel(const OdometryConfig& config) : config_(config) {}
@@ -114,7 +115,7 @@ bool MotionModel::within_gate(const Pose& predicted, const Pose& estimate) const
   if (prior_.turn_reach > 0.0) {
     const Pose last = predicted * prior_.motion.inverse();
     const Pose turn = prior_.motion.inverse() * (last.inverse() * estimate);
-    if (near(last * along_an_arc(prior_.motion, yaw_of(turn)))) return true;
+    if (near(last * along_an_arc(prior_.motion, to_xyz_rpy(turn)(5)))) return true;
   }
   if (!prior_.gap) return false;
   // Fractions of the motion from the last pose, spaced closer than the radius (riverside02's car

@@ -41,11 +41,11 @@ struct MotionPrior {
 
 /// `motion` scaled along its own twist: factor 2 is the same motion twice (constant velocity).
 Pose scaled_motion(const Pose& motion, double factor);
-/// `motion` turned by `yaw` about the sensor's z axis at its end, its translation by half of it:
-/// the same path length bent along an arc, as a vehicle that turned `yaw` more on the way.
+/// `motion` turned by `yaw` about the sensor's z axis at its end, its translation as it was.
+Pose turned_about_z(const Pose& motion, double yaw);
+/// turned_about_z with the translation turned by half of `yaw`: the same path length bent along
+/// an arc, as a vehicle that turned `yaw` more on the way.
 Pose along_an_arc(const Pose& motion, double yaw);
-/// The rotation of `motion` about the sensor's z axis (rad).
-double yaw_of(const Pose& motion);
 
 class MotionModel {
  public:
