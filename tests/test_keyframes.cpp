@@ -652,13 +652,15 @@ TEST(AdaptiveRules, AStartOutsideTheGateGivesWayToTheOptimumInside) {
   // rotation is within 1.5 degrees of the reference's (measured at most 1.17).
   const std::string folder = scanmatch::testing::shared_data("data/3d/riverside02_keyframes");
   if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/riverside02_keyframes not present";
+  // Every start on 1-6 s steps: 30 times slower sanitized, where the keyframe sets below run it.
+  if (sanitized()) GTEST_SKIP() << "41 keyframes with every start: too slow sanitized";
   const Trajectory reference = read_trajectory(folder + "/odom_poses.txt");
   std::vector<double> times;
   {
     std::ifstream in(folder + "/times.txt");
     for (double t = 0.0; in >> t;) times.push_back(t);
   }
-  const std::size_t frames = sanitized() ? 37 : 41;
+  const std::size_t frames = 41;
   ASSERT_GE(times.size(), frames);
   Odometry odometry(OdometryConfig{});
   std::vector<Pose> poses;

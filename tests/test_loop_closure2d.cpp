@@ -627,6 +627,8 @@ TEST(LoopClosure2D, CliWritesTheLoopClosedRun) {
 
 TEST(LoopClosure2D, OnItsOwnThreadItClosesTheSameLoopsAsInline) {
   // Loop closure sees the same scans in the same order either way: the same loops and poses.
+  // (CliWritesTheLoopClosedRun runs the thread under the sanitizers.)
+  if (scanmatch::testing::sanitized()) GTEST_SKIP() << "600 scans twice: too slow sanitized";
   scanmatch::testing::TempDir dir;
   const std::string common =
       "map2d sim:room-2d --scans 600 --method pl-icp --no-motion-distortion --loop-closure "
@@ -655,6 +657,7 @@ TEST(LoopClosure2D, OnItsOwnThreadItClosesTheSameLoopsAsInline) {
 TEST(LoopClosure2D, CarmenLogStartIfPresent) {
   const std::string log = scanmatch::testing::shared_data("data/2d/carmen/intel-corrected.log.gz");
   if (log.empty()) GTEST_SKIP() << "../shared/data/2d/carmen is absent";
+  if (scanmatch::testing::sanitized()) GTEST_SKIP() << "1500 scans: too slow sanitized";
   scanmatch::testing::TempDir dir;
   const auto r = scanmatch::testing::run_cli(
       "map2d " + log + " --scans 1500 --loop-closure --quiet --out " + dir.file("run"));

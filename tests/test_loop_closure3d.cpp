@@ -330,6 +330,7 @@ TEST(LoopClosure3D, RepeatedStructureGivesNoWrongEdge) {
   // Down the street 70 m on the right lane, a U-turn, and back on the other lane: every place on
   // the way back is revisited, and aliases of it lie every 20 m. The odometry drifts a few metres
   // (less than the 20 m spacing: loop closure cannot know which copy it is at beyond that).
+  if (scanmatch::testing::sanitized()) GTEST_SKIP() << "150 ray-cast frames: too slow sanitized";
   std::vector<Pose> truth_scene;
   for (double x = 0; x <= 70; x += 1.0) truth_scene.push_back(from_xyz_rpy(x, -2, 0.5, 0, 0, 0));
   for (double a = 0.25; a < M_PI; a += 0.25)
@@ -453,6 +454,8 @@ void expect_same_loop_closed_runs(const std::string& a, const std::string& b) {
 }
 
 TEST(LoopClosure3D, OnItsOwnThreadItClosesTheSameLoopsAsInline) {
+  // (RunOdometryWritesTheLoopClosedRun runs the thread under the sanitizers.)
+  if (scanmatch::testing::sanitized()) GTEST_SKIP() << "the loop twice: too slow sanitized";
   scanmatch::testing::TempDir dir;
   const auto threaded_source = short_campus_loop_sequence();
   const RunSummary threaded = run_with_loop_closure(*threaded_source, dir.file("thread"));
