@@ -35,6 +35,10 @@ void describe(Mapper2DConfig& c, Visitor& v) {
     "m: search again over +- this where the step is weak or open (0: off)");
   v("long_search_below", c.long_search_below, nullptr,
     "share of points fitting below which the long search runs");
+  v("reference_fit_below", c.reference_fit_below, nullptr,
+    "share of points fitting below which a scan is not the next scan's reference (0: off)");
+  v("max_unfit_references_skipped", c.max_unfit_references_skipped, nullptr,
+    "scans in a row at most kept from being the reference for fitting poorly");
   v.nested("registration", c.registration);
 }
 

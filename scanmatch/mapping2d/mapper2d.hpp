@@ -82,6 +82,16 @@ struct Mapper2DConfig {
   /// short along a corridor; within +-1.3 m of that prior only a wrong pose fits. 0: off.
   double long_search_window = 3.5;
   double long_search_below = 0.7;
+  /// With the correlative search on, a scan of which fewer than this share of the points fit
+  /// its reference is not made the next scan's reference: it shows little of the scene the
+  /// scans about it see (a laser pitched onto the ground, people beside it, open space), its
+  /// step is the motion prior's guess, and scan to scan every later pose would inherit that
+  /// guess's error (freiburg-campus's robot weaves 10-12 deg a scan one way and back, and such
+  /// steps took the prior's turn the wrong way). The next scan registers onto the older
+  /// reference; at most `max_unfit_references_skipped` scans in a row, as the scene moves on.
+  /// 0: off.
+  double reference_fit_below = 0.2;
+  int max_unfit_references_skipped = 3;
 };
 
 class Mapper2D {
@@ -114,6 +124,7 @@ class Mapper2D {
   Pose2 keyframe_pose_ = Pose2::Identity();
   Pose2 pose_ = Pose2::Identity(), motion_ = Pose2::Identity();
   std::size_t scans_ = 0;
+  int unfit_references_skipped_ = 0;  ///< scans in a row not made the reference
   Scan2DStats stats_;
 };
 

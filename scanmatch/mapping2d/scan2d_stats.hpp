@@ -27,6 +27,8 @@ struct Scan2DStats {
   /// Share of the points within 15 cm of the reference's surfaces at the searched pose (before
   /// the fine stage); -1 where no search ran. The step's health beside its error.
   double fit = -1.0;
+  /// The scan fit too poorly to be the next scan's reference (reference_fit_below).
+  bool unfit_reference = false;
 };
 
 template <typename Stats, typename Visitor>
@@ -48,6 +50,8 @@ void describe(Stats& s, Visitor& v) {
     "in doubt");
   v("long_search", s.long_search, "the long search ran (long_search_window)");
   v("long_search_won", s.long_search_won, "the long search's pose won");
+  v("unfit_reference", s.unfit_reference,
+    "the scan fit too poorly to be the next scan's reference (reference_fit_below)");
 }
 
 }  // namespace scanmatch
