@@ -35,12 +35,28 @@ double degrees(double rad) {
   return rad * 180 / M_PI;
 }
 
+struct Segment {
+  Vec2 a, b;
+};
+
+// The range along the ray from `origin` in direction `d` to the nearest of `walls`; infinity where
+// it meets none.
+double nearest_wall(const std::vector<Segment>& walls, const Vec2& origin, const Vec2& d) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Segment& w : walls) {
+    // origin + t d = a + s (b - a)
+    Eigen::Matrix2d A;
+    A << d, w.a - w.b;
+    if (std::abs(A.determinant()) < 1e-12) continue;
+    const Vec2 ts = A.inverse() * (w.a - origin);
+    if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) best = std::min(best, ts.x());
+  }
+  return best;
+}
+
 // A noiseless 360-beam scan of the L-shaped room of walls x = 0, x = 6, y = 0, y = 4 with a
 // 2 m x 1 m block in the corner (x in [4, 6], y in [3, 4]), from `pose` (x, y, yaw).
 Scan2D room_scan(const Pose2& pose) {
-  struct Segment {
-    Vec2 a, b;
-  };
   const std::vector<Segment> walls = {{{0, 0}, {6, 0}}, {{6, 0}, {6, 3}}, {{6, 3}, {4, 3}},
                                       {{4, 3}, {4, 4}}, {{4, 4}, {0, 4}}, {{0, 4}, {0, 0}}};
   Scan2D scan;
@@ -49,15 +65,7 @@ Scan2D room_scan(const Pose2& pose) {
   for (int beam = 0; beam < 360; ++beam) {
     const double angle = pose2_angle(pose) + beam * M_PI / 180;
     const Vec2 d(std::cos(angle), std::sin(angle));
-    double best = std::numeric_limits<double>::infinity();
-    for (const Segment& w : walls) {
-      // origin + t d = a + s (b - a)
-      Eigen::Matrix2d A;
-      A << d, w.a - w.b;
-      if (std::abs(A.determinant()) < 1e-12) continue;
-      const Vec2 ts = A.inverse() * (w.a - origin);
-      if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) best = std::min(best, ts.x());
-    }
+    const double best = nearest_wall(walls, origin, d);
     if (std::isfinite(best)) scan.points.push_back(pose.inverse() * (origin + best * d));
   }
   return scan;
@@ -966,9 +974,6 @@ namespace {
 /// scan's pose is its exact truth.
 std::vector<LaserScan2D> weaving_yard_scans(std::size_t count,
                                             const std::vector<std::size_t>& ground) {
-  struct Segment {
-    Vec2 a, b;
-  };
   const std::vector<Segment> fronts = {
       {{-8, -9}, {18, -9}}, {{18, -9}, {18, 2}}, {{18, 5}, {18, 12}}, {{18, 12}, {-8, 12}},
       {{-8, 12}, {-8, -9}}, {{7, 3}, {10, 3}},   {{10, 3}, {10, 6}},  {{10, 6}, {7, 6}},
@@ -996,13 +1001,7 @@ std::vector<LaserScan2D> weaving_yard_scans(std::size_t count,
         range = 9.0 - 4.0 * std::abs(std::sin(local)) + 0.4 * std::sin(2.7 * beam * beam);
       } else {
         const Vec2 d(std::cos(yaw + local), std::sin(yaw + local));
-        for (const Segment& w : fronts) {
-          Eigen::Matrix2d A;
-          A << d, w.a - w.b;
-          if (std::abs(A.determinant()) < 1e-12) continue;
-          const Vec2 ts = A.inverse() * (w.a - position);
-          if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) range = std::min(range, ts.x());
-        }
+        range = std::min(range, nearest_wall(fronts, position, d));
       }
       scan.ranges.push_back(static_cast<float>(range));
     }
