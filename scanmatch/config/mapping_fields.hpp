@@ -201,6 +201,10 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
     "... plus this share of the path between the two keyframes");
   v("registration_reach", o.registration_reach, nullptr,
     "How far verification can move a place-database match, m (negative: all are verified)");
+  v("widening_per_weak_step", o.widening_per_weak_step, nullptr,
+    "Each weak odometry step between two keyframes widens their loop search by this factor more");
+  v("max_doubt_widening", o.max_doubt_widening, nullptr,
+    "... up to this many times the proximity radius and search window");
   v("search_every", o.search_every, nullptr, "Look for loops at every this-many keyframes");
   v("keyframes_between_loops", o.keyframes_between_loops, nullptr,
     "Keyframes without a search after one that added a loop");

@@ -57,14 +57,16 @@ using LoopCandidateReach = std::function<double(std::size_t k)>;
 /// or 3D) among the keyframes before the newest `skip_recent`. Of the place database, its best
 /// `descriptor_matches` matches (at least max_descriptor_candidates) are looked at, best first:
 /// look-alike places often match better than the true one, so those farther than `reach` are
-/// skipped and the best remaining ones taken.
+/// skipped and the best remaining ones taken. `proximity`, where given, is keyframe k's proximity
+/// radius (default: options.proximity_radius).
 template <int Dim, class Descriptor>
 LoopCandidates find_loop_candidates(std::size_t keyframe, std::size_t skip_recent,
                                     const PoseGraph<Dim>& estimate,
                                     const PlaceDatabase<Descriptor>& places,
                                     const LoopCandidateOptions& options,
                                     std::size_t descriptor_matches = 0,
-                                    const LoopCandidateReach& reach = {}) {
+                                    const LoopCandidateReach& reach = {},
+                                    const LoopCandidateReach& proximity = {}) {
   LoopCandidates out;
   if (keyframe <= skip_recent) return out;
   out.end = keyframe - skip_recent;
@@ -76,7 +78,7 @@ LoopCandidates find_loop_candidates(std::size_t keyframe, std::size_t skip_recen
     std::vector<std::pair<double, std::size_t>> near;
     for (std::size_t k = 0; k < out.end; ++k) {
       const double d = distance(k);
-      if (d <= options.proximity_radius) near.emplace_back(d, k);
+      if (d <= (proximity ? proximity(k) : options.proximity_radius)) near.emplace_back(d, k);
     }
     std::sort(near.begin(), near.end());
     // Nearest first, but not several neighbours of one visit: they would verify the same loop.

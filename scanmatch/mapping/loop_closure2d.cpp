@@ -53,6 +53,11 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error("loop closure: optimize_above must not be negative");
   if (std::isnan(options.registration_reach))
     throw Error("loop closure: registration_reach must be a number (negative: off)");
+  if (!(options.widening_per_weak_step >= 0.0) || !std::isfinite(options.widening_per_weak_step) ||
+      !(options.max_doubt_widening >= 0.0) || !std::isfinite(options.max_doubt_widening))
+    throw Error(
+        "loop closure: widening_per_weak_step and max_doubt_widening must be finite and not "
+        "negative");
   if (!(options.recheck_above >= 0.0))
     throw Error("loop closure: recheck_above must not be negative");
   if (!(options.verification.min_search_score >= 0.0 &&
@@ -68,6 +73,7 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
 bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, bool weak_fit) {
   const Stopwatch stopwatch;
   weak_fit_since_keyframe_ = weak_fit_since_keyframe_ || weak_fit;
+  weak_steps_ += weak_fit;
   // A non-finite odometry pose would poison the graph: hold the last one instead.
   Pose2 odometry = odometry_pose;
   if (!odometry.matrix().allFinite())
@@ -97,6 +103,7 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, boo
     k.scan = scans();
     k.points = scan;
     k.odometry = odometry;
+    k.weak_steps = weak_steps_;
     const std::size_t index = keyframes_.size();
     if (index == 0) {
       graph_.graph().add_node(odometry);
@@ -152,8 +159,11 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
       return turnable ? std::numeric_limits<double>::infinity()
                       : correction_allowed(k, keyframe) + options_.registration_reach;
     };
-  const LoopCandidates found = find_loop_candidates(keyframe, options_.skip_recent, graph(),
-                                                    places_, options_.candidates, 0, reach);
+  const LoopCandidateReach proximity = [&](std::size_t k) {
+    return options_.candidates.proximity_radius * doubt_widening(k, keyframe);
+  };
+  const LoopCandidates found = find_loop_candidates(
+      keyframe, options_.skip_recent, graph(), places_, options_.candidates, 0, reach, proximity);
   counts_.ruled_out_by_estimate += found.ruled_out;
   const Pose2& here = graph().pose(keyframe);
   bool stale = false;
@@ -176,8 +186,11 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     // The descriptor knows the yaw only: the translation is left to the search window.
     const Pose2 initial = candidate.by_descriptor ? pose2(0.0, 0.0, candidate.yaw) : estimated;
     if (!current) current.emplace(keyframes_[keyframe].points, options_.verification);
-    const LoopVerification2D v = verify_loop_2d(*current, prepared_reference(k, joined), initial,
-                                                options_.verification, estimated);
+    // The prepared scans do not depend on the window.
+    LoopVerification2DOptions verification = options_.verification;
+    verification.search_window *= doubt_widening(k, keyframe);
+    const LoopVerification2D v =
+        verify_loop_2d(*current, prepared_reference(k, joined), initial, verification, estimated);
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;
@@ -238,6 +251,13 @@ const LoopReference2D& LoopClosure2D::prepared_reference(std::size_t keyframe,
   if (prepared_.size() >= kPreparedReferences) prepared_.erase(prepared_.begin());
   prepared_.push_back(std::move(wanted));
   return *prepared_.back().reference;
+}
+
+double LoopClosure2D::doubt_widening(std::size_t older, std::size_t newer) const {
+  const double weak =
+      static_cast<double>(keyframes_[newer].weak_steps - keyframes_[older].weak_steps);
+  return std::min(1.0 + options_.widening_per_weak_step * weak,
+                  std::max(1.0, options_.max_doubt_widening));
 }
 
 double LoopClosure2D::correction_allowed(std::size_t older, std::size_t newer) const {

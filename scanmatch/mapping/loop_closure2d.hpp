@@ -121,6 +121,14 @@ struct LoopClosure2DOptions {
   /// their candidates are ruled out (intel 177 of 2002, ACES 211 of 846). Negative: every match
   /// is verified.
   double registration_reach = 7.0;
+  /// The odometry's doubt between two keyframes widens the search between them: each weak step
+  /// between them (a scan few points of which fit: Mapper2D's weak_fit) scales the proximity
+  /// radius and the verification's search window by this much more, up to max_doubt_widening
+  /// times. freiburg-campus's revisits after 140-250 weak steps lay 3-11 m apart in the estimate,
+  /// beyond 4 m; a ring of plain corridors, whose odometry fits (corridor-2d: at most 2 weak
+  /// steps), keeps the narrow search, where a wide one finds aliases. 0: off.
+  double widening_per_weak_step = 0.01;
+  double max_doubt_widening = 2.5;
   /// Loop edges are looked for at every this-many keyframes (1: each one) ...
   std::size_t search_every = 1;
   /// ... and not at the next this-many keyframes after one that added a loop edge: on a second
@@ -219,10 +227,15 @@ class LoopClosure2D {
     Scan2D points;
     Pose2 odometry = Pose2::Identity();
     double path = 0.0;           ///< m of odometry travel since the first keyframe
+    std::size_t weak_steps = 0;  ///< weak-fit scans since the first scan
     bool rotation_open = false;  ///< the odometry edge from the previous keyframe is so
   };
   /// A scan since the last keyframe was registered with a weak fit (add_scan's weak_fit).
   bool weak_fit_since_keyframe_ = false;
+  std::size_t weak_steps_ = 0;  ///< weak-fit scans so far
+  /// How much wider the search between keyframe `newer` and an older one is
+  /// (widening_per_weak_step).
+  double doubt_widening(std::size_t older, std::size_t newer) const;
   /// Searches loops for the new keyframe, optimizes when they disagree with the estimate, and
   /// searches again for the keyframes before it when that moved the estimate far.
   void close_loops(std::size_t keyframe);
