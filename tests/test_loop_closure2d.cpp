@@ -603,6 +603,8 @@ TEST(LoopClosure2D, OptionsOutOfRangeAreRefused) {
   refused([](LoopClosure2DOptions& o) { o.optimize_above = -0.1; });
   refused([](LoopClosure2DOptions& o) { o.recheck_above = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.registration_reach = std::nan(""); });
+  refused([](LoopClosure2DOptions& o) { o.widening_per_weak_step = -0.01; });
+  refused([](LoopClosure2DOptions& o) { o.max_doubt_widening = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.odometry_spread_margin = -0.01; });
   refused([](LoopClosure2DOptions& o) { o.odometry_spread_window = std::nan(""); });
   refused([](LoopClosure2DOptions& o) { o.rotation_open_ratio = -0.1; });

@@ -1088,6 +1088,8 @@ TEST(Map2D, MapperRefusesOptionsOutOfRangeBeforeTheFirstScan) {
   refused([](Mapper2DConfig& c) { c.full_turn_search_below = std::nan(""); });
   refused([](Mapper2DConfig& c) { c.open_step_window = -1.0; });
   refused([](Mapper2DConfig& c) { c.open_step_prior_distance = std::nan(""); });
+  refused([](Mapper2DConfig& c) { c.reference_fit_below = std::nan(""); });
+  refused([](Mapper2DConfig& c) { c.max_unfit_references_skipped = -1; });
   EXPECT_NO_THROW(Mapper2D{Mapper2DConfig{}});
 }
 
