@@ -652,7 +652,7 @@ TEST(AdaptiveRules, AStartOutsideTheGateGivesWayToTheOptimumInside) {
   // rotation is within 1.5 degrees of the reference's (measured at most 1.17).
   const std::string folder = scanmatch::testing::shared_data("data/3d/riverside02_keyframes");
   if (folder.empty()) GTEST_SKIP() << "../shared/data/3d/riverside02_keyframes not present";
-  // Every start on 1-6 s steps: 30 times slower sanitized, where the keyframe sets below run it.
+  // Every start on 1-6 s steps: the simulated keyframe sets run that path sanitized.
   if (sanitized()) GTEST_SKIP() << "41 keyframes with every start: too slow sanitized";
   const Trajectory reference = read_trajectory(folder + "/odom_poses.txt");
   std::vector<double> times;

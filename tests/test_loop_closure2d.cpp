@@ -11,6 +11,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "planar_scene.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics2d.hpp"
 #include "scanmatch/mapping/edge_information.hpp"
@@ -24,9 +25,7 @@
 namespace scanmatch {
 namespace {
 
-struct Segment {
-  Eigen::Vector2d a, b;
-};
+using scanmatch::testing::Segment;
 
 // A 180-degree laser (1-degree beams, returns up to 30 m) at `pose` among `walls`, in its frame.
 Scan2D half_scan(const std::vector<Segment>& walls, const Pose2& pose) {
@@ -35,14 +34,7 @@ Scan2D half_scan(const std::vector<Segment>& walls, const Pose2& pose) {
   for (int beam = 0; beam <= 180; ++beam) {
     const double a = pose2_angle(pose) + (beam - 90) * M_PI / 180;
     const Eigen::Vector2d d(std::cos(a), std::sin(a));
-    double best = 30.0;
-    for (const Segment& w : walls) {
-      Eigen::Matrix2d A;
-      A << d, w.a - w.b;
-      if (std::abs(A.determinant()) < 1e-12) continue;
-      const Eigen::Vector2d ts = A.inverse() * (w.a - o);
-      if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) best = std::min(best, ts.x());
-    }
+    const double best = scanmatch::testing::nearest_wall(walls, o, d);
     if (best < 30.0) scan.points.push_back(pose.inverse() * (o + best * d));
   }
   return scan;
@@ -322,10 +314,7 @@ TEST(LoopClosure2D, WeakStepsBetweenKeyframesWidenTheirSearch) {
   // beyond the verification's 2 m search window. Where the scans that went wrong were weak, the
   // search between the keyframes about them widens and the loop closes; where the odometry
   // fitted, the search stays narrow.
-  const std::vector<Segment> fronts = {
-      {{-8, -9}, {18, -9}}, {{18, -9}, {18, 2}}, {{18, 5}, {18, 12}}, {{18, 12}, {-8, 12}},
-      {{-8, 12}, {-8, -9}}, {{7, 3}, {10, 3}},   {{10, 3}, {10, 6}},  {{10, 6}, {7, 6}},
-      {{7, 6}, {7, 3}},     {{-3, -6}, {2, -5}}, {{14, 9}, {16, 10}}};
+  const std::vector<Segment> fronts = scanmatch::testing::yard_fronts();
   std::vector<Pose2> truth;
   const auto drive = [&](Eigen::Vector2d from, Eigen::Vector2d to, double heading) {
     const int steps = static_cast<int>(std::round((to - from).norm()));

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "planar_scene.hpp"
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/eval/metrics2d.hpp"
 #include "scanmatch/features/angle_histogram.hpp"
@@ -35,24 +36,8 @@ double degrees(double rad) {
   return rad * 180 / M_PI;
 }
 
-struct Segment {
-  Vec2 a, b;
-};
-
-// The range along the ray from `origin` in direction `d` to the nearest of `walls`; infinity where
-// it meets none.
-double nearest_wall(const std::vector<Segment>& walls, const Vec2& origin, const Vec2& d) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const Segment& w : walls) {
-    // origin + t d = a + s (b - a)
-    Eigen::Matrix2d A;
-    A << d, w.a - w.b;
-    if (std::abs(A.determinant()) < 1e-12) continue;
-    const Vec2 ts = A.inverse() * (w.a - origin);
-    if (ts.x() > 0 && ts.y() >= 0 && ts.y() <= 1) best = std::min(best, ts.x());
-  }
-  return best;
-}
+using scanmatch::testing::nearest_wall;
+using scanmatch::testing::Segment;
 
 // A noiseless 360-beam scan of the L-shaped room of walls x = 0, x = 6, y = 0, y = 4 with a
 // 2 m x 1 m block in the corner (x in [4, 6], y in [3, 4]), from `pose` (x, y, yaw).
@@ -974,10 +959,7 @@ namespace {
 /// scan's pose is its exact truth.
 std::vector<LaserScan2D> weaving_yard_scans(std::size_t count,
                                             const std::vector<std::size_t>& ground) {
-  const std::vector<Segment> fronts = {
-      {{-8, -9}, {18, -9}}, {{18, -9}, {18, 2}}, {{18, 5}, {18, 12}}, {{18, 12}, {-8, 12}},
-      {{-8, 12}, {-8, -9}}, {{7, 3}, {10, 3}},   {{10, 3}, {10, 6}},  {{10, 6}, {7, 6}},
-      {{7, 6}, {7, 3}},     {{-3, -6}, {2, -5}}};
+  const std::vector<Segment> fronts = scanmatch::testing::yard_fronts();
   std::vector<LaserScan2D> scans;
   double yaw = 0.0;
   Vec2 position(0.0, 0.0);
