@@ -18,7 +18,7 @@ struct Map2DCommand {
   std::string sequence, out, initial = "constant-velocity", topic, config_file;
   std::size_t scans = 0, first_scan = 0;
   std::uint64_t seed = 1;
-  bool no_motion_distortion = false, infer_no_return = false;
+  bool no_motion_distortion = false, infer_no_return = true;
   double rotation_period = -1.0;  ///< s; negative: the input's own
   double search_angle_deg = 45.0, wide_search_angle_deg = 90.0, keyframe_angle_deg = 0.0;
   Map2DRunOptions run, defaults;
@@ -88,9 +88,9 @@ void add_map2d_command(CLI::App& app) {
   cmd->add_option("--rotation-period", c->rotation_period,
                   "s per turn of the laser, for deskewing (default: the simulated sensor's; "
                   "unknown for logs, so they are not deskewed)");
-  cmd->add_flag("--no-return-reading", c->infer_no_return,
-                "CARMEN FLASER logs: take the reading the log's far end repeats (a laser's "
-                "in-range no-return code, 51.15 m on acapulco) for no return, not for points");
+  cmd->add_flag("--no-return-reading,!--range-codes-as-points", c->infer_no_return,
+                "CARMEN FLASER logs: the reading the log's far end repeats (a laser's in-range "
+                "no-return code, 51.15 m on acapulco) is no return (the default), or points");
   cmd->add_flag("--quiet", c->run.quiet, "No progress and no summary lines");
   cmd->callback([c, cmd] {
     Map2DRunOptions run = configuration(*c, *cmd);

@@ -181,11 +181,12 @@ TEST(Carmen, FlaserNoReturnReadingIsInferredFromTheLog) {
     text += flaser(ranges);
     spread += flaser(plain);
   }
-  CarmenReadOptions inferring;
-  inferring.infer_no_return = true;
-  // Off by default: the scans keep 80 m.
-  EXPECT_FLOAT_EQ(parse_carmen_log(text, "no_return.log").scans[0].max_range, 80.0f);
-  const CarmenLog log = parse_carmen_log(text, "no_return.log", inferring);
+  // On by default; off, the scans keep 80 m.
+  CarmenReadOptions as_points;
+  as_points.infer_no_return = false;
+  EXPECT_FLOAT_EQ(parse_carmen_log(text, "no_return.log", as_points).scans[0].max_range, 80.0f);
+  const CarmenReadOptions inferring;
+  const CarmenLog log = parse_carmen_log(text, "no_return.log");
   ASSERT_EQ(log.scans.size(), 20u);
   EXPECT_NEAR(log.scans[0].max_range, 32.747, 1e-4);
   EXPECT_NEAR(*no_return_reading(log.scans), 32.747, 1e-4);

@@ -39,6 +39,10 @@ void describe(Mapper2DConfig& c, Visitor& v) {
     "share of points fitting below which a scan is not the next scan's reference (0: off)");
   v("max_unfit_references_skipped", c.max_unfit_references_skipped, nullptr,
     "scans in a row at most kept from being the reference for fitting poorly");
+  v("submap_scans", c.submap_scans, nullptr,
+    "references the search scores against: the last and the ones before it (1: scan to scan)");
+  v("submap_link_fit", c.submap_link_fit, nullptr,
+    "share of points fitting below which a step lets the older references go");
   v.nested("registration", c.registration);
 }
 

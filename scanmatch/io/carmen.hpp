@@ -54,10 +54,9 @@ struct CarmenReadOptions {
   /// fov / (n - 1) for an odd count (181, 361) and fov / n for an even one (180, 360).
   double flaser_field_of_view = M_PI;
   /// FLASER: lower every scan's max_range to the log's own no-return reading (no_return_reading)
-  /// where it shows one below 80 m. Off by default: on acapulco it mends the open hall (2.59 ->
-  /// 0.31 m loop-closed), but ACES's 50 m arcs hold its corridor steps today (0.105 -> 0.336 m
-  /// without them; docs/planar.md).
-  bool infer_no_return = false;
+  /// where it shows one below 80 m: taken for returns, acapulco's 51.15 m codes made its open
+  /// hall come out standing still (docs/planar.md).
+  bool infer_no_return = true;
 };
 
 /// FLASER records carry no maximum range, and a laser reports "no return" as a reading of its

@@ -27,7 +27,7 @@ struct SequenceOptions {
   std::string reference;
   /// 2D CARMEN logs: FLASER scans take the log's own no-return reading for their maximum range
   /// (CarmenReadOptions::infer_no_return).
-  bool infer_no_return = false;
+  bool infer_no_return = true;
 };
 
 /// Opens `spec`:

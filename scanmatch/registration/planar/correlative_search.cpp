@@ -72,14 +72,17 @@ struct LikelihoodGrid {
 /// The grid spans the reference points only: a current point landing elsewhere scores nothing.
 /// Below them it reaches one top block further, so that the levels bound the blocks that start
 /// outside (`g.at` is zero off the grid). Coarser cells where the area is huge, so memory stays
-/// bounded.
-LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) {
+/// bounded. With `older` (surfaces of earlier scans, in the reference's frame) a cell holds the
+/// mean of the two sets' likelihoods, each code standing for code / 255.
+LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution,
+                         const std::vector<Vec2>& older = {}) {
   LikelihoodGrid g;
   Vec2 low = reference.front(), high = reference.front();
-  for (const Vec2& p : reference) {
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
-  }
+  for (const std::vector<Vec2>* points : {&reference, &older})
+    for (const Vec2& p : *points) {
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
   const auto cells = [&](double r) {
     const Vec2 size = high - low;
     return (size.x() / r + kTopSide + 6) * (size.y() / r + kTopSide + 6);
@@ -105,16 +108,27 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution) 
       kernel[dy + kRadius][dx + kRadius] = code;
       g.likelihood[code] = value;
     }
-  for (const Vec2& p : reference) {
-    const int cx = static_cast<int>(std::floor((p.x() - low.x()) / resolution));
-    const int cy = static_cast<int>(std::floor((p.y() - low.y()) / resolution));
-    for (int dy = -kRadius; dy <= kRadius; ++dy)
-      for (int dx = -kRadius; dx <= kRadius; ++dx) {
-        const int x = cx + dx, y = cy + dy;
-        if (x < 0 || y < 0 || x >= g.width || y >= g.height) continue;
-        Code& cell = fine[static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)];
-        cell = std::max(cell, kernel[dy + kRadius][dx + kRadius]);
-      }
+  const auto stamp = [&](const std::vector<Vec2>& points, Code* layer) {
+    for (const Vec2& p : points) {
+      const int cx = static_cast<int>(std::floor((p.x() - low.x()) / resolution));
+      const int cy = static_cast<int>(std::floor((p.y() - low.y()) / resolution));
+      for (int dy = -kRadius; dy <= kRadius; ++dy)
+        for (int dx = -kRadius; dx <= kRadius; ++dx) {
+          const int x = cx + dx, y = cy + dy;
+          if (x < 0 || y < 0 || x >= g.width || y >= g.height) continue;
+          Code& cell = layer[static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)];
+          cell = std::max(cell, kernel[dy + kRadius][dx + kRadius]);
+        }
+    }
+  };
+  stamp(reference, fine);
+  if (!older.empty()) {
+    std::vector<Code> earlier(n, 0);
+    stamp(older, earlier.data());
+    for (std::size_t i = 0; i < n; ++i)
+      fine[i] = static_cast<Code>((fine[i] + earlier[i] + 1) / 2);  // rounded up: still a bound
+    for (int code = 0; code <= kCodeScale; ++code)
+      g.likelihood[static_cast<std::size_t>(code)] = static_cast<float>(code) / kCodeScale;
   }
   // Each level from the one below: the maximum of kBranch cells `stride` apart along +x, then, in
   // place, along +y (row y reads only rows after it, not yet overwritten). Off the grid counts as
@@ -500,14 +514,23 @@ struct CorrelativeGrid::Impl {
 };
 
 CorrelativeGrid::CorrelativeGrid(const Scan2D& reference, double resolution, double fill_gap)
+    : CorrelativeGrid(filled_surfaces(reference, fill_gap, resolution), {}, resolution) {}
+
+CorrelativeGrid::CorrelativeGrid(const std::vector<Vec2>& newest, const std::vector<Vec2>& older,
+                                 double resolution)
     : requested_resolution_(resolution) {
   if (!(resolution > 0.0)) throw Error("correlative search: resolution must be positive");
-  std::vector<Vec2> surfaces;
-  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
-    if (q.allFinite()) surfaces.push_back(q);
+  const auto finite = [](const std::vector<Vec2>& points) {
+    std::vector<Vec2> out;
+    out.reserve(points.size());
+    for (const Vec2& q : points)
+      if (q.allFinite()) out.push_back(q);
+    return out;
+  };
+  const std::vector<Vec2> surfaces = finite(newest);
   if (surfaces.empty()) return;
   auto impl = std::make_shared<Impl>();
-  impl->grid = std::make_shared<LikelihoodGrid>(make_grid(surfaces, resolution));
+  impl->grid = std::make_shared<LikelihoodGrid>(make_grid(surfaces, resolution, finite(older)));
   impl_ = std::move(impl);
 }
 

@@ -24,6 +24,12 @@ class CorrelativeGrid {
   /// Throws Error unless `resolution` is positive. An empty reference gives an empty grid, onto
   /// which no search finds anything.
   CorrelativeGrid(const Scan2D& reference, double resolution, double fill_gap = 0.0);
+  /// From surface points already filled (filled_surfaces): the newest reference's and, where
+  /// `older` holds any (earlier references' surfaces in the newest one's frame), the mean of the
+  /// two sets' likelihoods: returns that line up with the newest reference only where the sensor
+  /// did not move (samples of walls at a grazing angle) do not line up with the older ones.
+  CorrelativeGrid(const std::vector<Eigen::Vector2d>& newest,
+                  const std::vector<Eigen::Vector2d>& older, double resolution);
   bool empty() const { return impl_ == nullptr; }
   double resolution() const {
     return requested_resolution_;
