@@ -126,7 +126,7 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution,
     std::vector<Code> earlier(n, 0);
     stamp(older, earlier.data());
     for (std::size_t i = 0; i < n; ++i)
-      fine[i] = static_cast<Code>((fine[i] + earlier[i] + 1) / 2);  // rounded up: still a bound
+      fine[i] = static_cast<Code>((fine[i] + earlier[i] + 1) / 2);  // the mean, rounded up
     for (int code = 0; code <= kCodeScale; ++code)
       g.likelihood[static_cast<std::size_t>(code)] = static_cast<float>(code) / kCodeScale;
   }
