@@ -165,11 +165,9 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
       std::vector<Eigen::Vector2d> newest =
           filled_surfaces(reference, o.search_fill_gap, o.search_resolution);
       std::vector<Eigen::Vector2d> older;
-      for (const auto& [older_scan, older_pose] : older_references_) {
+      for (const auto& [surfaces, older_pose] : older_references_) {
         const Pose2 into = keyframe_pose_.inverse() * older_pose;
-        for (const Eigen::Vector2d& q :
-             filled_surfaces(older_scan, o.search_fill_gap, o.search_resolution))
-          older.push_back(into * q);
+        for (const Eigen::Vector2d& q : surfaces) older.push_back(into * q);
       }
       const CorrelativeGrid grid(newest, older, o.search_resolution);
       // Each search's score (correlative_match's share) beside its refined pose.
@@ -298,7 +296,10 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
     if (stats_.bridged || stats_.fit < config_.submap_link_fit) {
       older_references_.clear();
     } else if (config_.submap_scans > 1) {
-      older_references_.emplace_front(std::move(keyframe_), keyframe_pose_);
+      // Filled once here, not at every step that searches against it.
+      const Registration2DOptions& o = config_.registration;
+      older_references_.emplace_front(
+          filled_surfaces(keyframe_, o.search_fill_gap, o.search_resolution), keyframe_pose_);
       if (older_references_.size() >= static_cast<std::size_t>(config_.submap_scans))
         older_references_.pop_back();
     }

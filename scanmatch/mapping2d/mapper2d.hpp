@@ -7,6 +7,7 @@
 #include <deque>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "scanmatch/core/scan2d.hpp"
 #include "scanmatch/mapping2d/scan2d_stats.hpp"
@@ -132,9 +133,9 @@ class Mapper2D {
 
   Mapper2DConfig config_;
   Scan2D keyframe_, last_scan_;
-  /// The references before keyframe_ still in the search (submap_scans), newest first, with
-  /// their poses.
-  std::deque<std::pair<Scan2D, Pose2>> older_references_;
+  /// The references before keyframe_ still in the search (submap_scans), newest first: their
+  /// filled surfaces (filled_surfaces, in their own frames) and their poses.
+  std::deque<std::pair<std::vector<Eigen::Vector2d>, Pose2>> older_references_;
   double last_timestamp_ = 0.0, motion_interval_ = 0.0;  ///< s; motion_ took motion_interval_
   Pose2 keyframe_pose_ = Pose2::Identity();
   Pose2 pose_ = Pose2::Identity(), motion_ = Pose2::Identity();
