@@ -8,6 +8,8 @@
 #include <optional>
 #include <utility>
 
+#include <tbb/parallel_for.h>
+
 #include "scanmatch/core/error.hpp"
 #include "scanmatch/core/stopwatch.hpp"
 #include "scanmatch/mapping/edge_information.hpp"
@@ -167,6 +169,18 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
   counts_.ruled_out_by_estimate += found.ruled_out;
   const Pose2& here = graph().pose(keyframe);
   bool stale = false;
+  // Each candidate's verification, prepared in order (the prepared references' cache is not
+  // shared across threads), run side by side (each reads only its own reference, the shared
+  // current scan and the graph as it stood), then judged in order as if run one by one: adding
+  // a loop edge moves no pose before the next optimization.
+  struct Tried {
+    std::size_t keyframe;
+    Pose2 estimated, initial;
+    std::shared_ptr<const LoopReference2D> reference;
+    LoopVerification2DOptions verification;
+    LoopVerification2D result;
+  };
+  std::vector<Tried> tried;
   std::optional<LoopCurrent2D> current;  // for all of the keyframe's candidates
   for (const LoopCandidate& candidate : found.candidates) {
     const std::size_t k = candidate.keyframe;
@@ -185,12 +199,20 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     const Pose2 estimated = graph().pose(k).inverse() * here;
     // The descriptor knows the yaw only: the translation is left to the search window.
     const Pose2 initial = candidate.by_descriptor ? pose2(0.0, 0.0, candidate.yaw) : estimated;
-    if (!current) current.emplace(keyframes_[keyframe].points, options_.verification);
     // The prepared scans do not depend on the window.
     LoopVerification2DOptions verification = options_.verification;
     verification.search_window *= doubt_widening(k, keyframe);
-    const LoopVerification2D v =
-        verify_loop_2d(*current, prepared_reference(k, joined), initial, verification, estimated);
+    if (!current) current.emplace(keyframes_[keyframe].points, options_.verification);
+    tried.push_back({k, estimated, initial, prepared_reference(k, joined), verification, {}});
+  }
+  tbb::parallel_for(std::size_t{0}, tried.size(), [&](std::size_t i) {
+    Tried& t = tried[i];
+    t.result = verify_loop_2d(*current, *t.reference, t.initial, t.verification, t.estimated);
+  });
+  for (const Tried& t : tried) {
+    const std::size_t k = t.keyframe;
+    const Pose2& estimated = t.estimated;
+    const LoopVerification2D& v = t.result;
     if (!v.accepted) {
       ++counts_.rejected_by_verification;
       continue;
@@ -225,8 +247,8 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
   return stale;
 }
 
-const LoopReference2D& LoopClosure2D::prepared_reference(std::size_t keyframe,
-                                                         const std::vector<std::size_t>& joined) {
+std::shared_ptr<const LoopReference2D> LoopClosure2D::prepared_reference(
+    std::size_t keyframe, const std::vector<std::size_t>& joined) {
   PreparedReference wanted;
   wanted.keyframe = keyframe;
   for (const std::size_t j : joined)
@@ -242,15 +264,15 @@ const LoopReference2D& LoopClosure2D::prepared_reference(std::size_t keyframe,
   if (found != prepared_.end()) {
     // The most recently used last.
     std::rotate(found, found + 1, prepared_.end());
-    return *prepared_.back().reference;
+    return prepared_.back().reference;
   }
   std::vector<PosedScan2D> neighbours;
   for (const auto& [j, pose] : wanted.joined) neighbours.push_back({&keyframes_[j].points, pose});
-  wanted.reference = std::make_unique<LoopReference2D>(keyframes_[keyframe].points, neighbours,
-                                                       options_.verification);
+  wanted.reference = std::make_shared<const LoopReference2D>(keyframes_[keyframe].points,
+                                                             neighbours, options_.verification);
   if (prepared_.size() >= kPreparedReferences) prepared_.erase(prepared_.begin());
   prepared_.push_back(std::move(wanted));
-  return *prepared_.back().reference;
+  return prepared_.back().reference;
 }
 
 double LoopClosure2D::doubt_widening(std::size_t older, std::size_t newer) const {

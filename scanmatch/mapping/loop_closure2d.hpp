@@ -266,13 +266,14 @@ class LoopClosure2D {
   void optimize();
   /// Keyframe `keyframe` joined by the keyframes `joined` at their current relative poses,
   /// prepared for verification (kept for the next candidates: a keyframe is often the candidate
-  /// of several new keyframes while the estimate stays).
-  const LoopReference2D& prepared_reference(std::size_t keyframe,
-                                            const std::vector<std::size_t>& joined);
+  /// of several new keyframes while the estimate stays). Shared: it outlives its eviction from
+  /// the cache while verifications still use it.
+  std::shared_ptr<const LoopReference2D> prepared_reference(std::size_t keyframe,
+                                                            const std::vector<std::size_t>& joined);
   struct PreparedReference {
     std::size_t keyframe = 0;
     std::vector<std::pair<std::size_t, Pose2>> joined;  ///< each keyframe in `keyframe`'s frame
-    std::unique_ptr<const LoopReference2D> reference;
+    std::shared_ptr<const LoopReference2D> reference;
   };
   /// The prepared references kept (bounded memory), the most recently used last.
   static constexpr std::size_t kPreparedReferences = 16;
