@@ -31,6 +31,9 @@ void describe(Mapper2DConfig& c, Visitor& v) {
     "m: RMS spread of those translations from which the step counts as open");
   v("open_step_prior_distance", c.open_step_prior_distance, nullptr,
     "m: the prior chooses only when a fitting translation lies this near it");
+  v("open_step_speed_steps", c.open_step_speed_steps, nullptr,
+    "steps whose median length is the prior straight on where the turning prior is "
+    "contradicted (0: off)");
   v("long_search_window", c.long_search_window, nullptr,
     "m: search again over +- this where the step is weak or open (0: off)");
   v("long_search_below", c.long_search_below, nullptr,

@@ -18,10 +18,11 @@ Mapper2D::Mapper2D(const Mapper2DConfig& config) : config_(config) {
         "map2d: wide_search_angle, wide_search_below and full_turn_search_below must not be "
         "negative");
   if (!(config.open_step_window >= 0.0) || !(config.open_step_margin >= 0.0) ||
-      !(config.open_step_spread >= 0.0) || !(config.open_step_prior_distance >= 0.0))
+      !(config.open_step_spread >= 0.0) || !(config.open_step_prior_distance >= 0.0) ||
+      config.open_step_speed_steps < 0)
     throw Error(
-        "map2d: open_step_window, open_step_margin, open_step_spread and "
-        "open_step_prior_distance must not be negative");
+        "map2d: open_step_window, open_step_margin, open_step_spread, open_step_prior_distance "
+        "and open_step_speed_steps must not be negative");
   if (!(config.long_search_window >= 0.0) || !(config.long_search_below >= 0.0))
     throw Error("map2d: long_search_window and long_search_below must not be negative");
   if (!(config.reference_fit_below >= 0.0) || config.max_unfit_references_skipped < 0)
@@ -237,8 +238,27 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
       search_pose_fits = r.search_pose_kept && best > fit(current, guess);
       // The prior chooses along an open step only where it was not shown wrong by the long
       // search.
+      // After a turn the constant-velocity prior turns on: where the scans fit but leave the
+      // length open and no fitting translation lies near that prior, straight on at the recent
+      // speed (open_step_speed_steps).
+      Pose2 prior = guess;
+      if (open_step && open && !stats_.weak_fit && !stats_.long_search_won &&
+          !recent_step_lengths_.empty() &&
+          (spread.nearest.translation() - guess.translation()).norm() >
+              config_.open_step_prior_distance) {
+        std::vector<double> lengths(recent_step_lengths_.begin(), recent_step_lengths_.end());
+        const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+        std::nth_element(lengths.begin(), middle, lengths.end());
+        // From the last scan's pose, along the heading registered for this one.
+        const Pose2 last = keyframe_pose_.inverse() * pose_;
+        const double turn = pose2_angle(last.inverse() * r.transform);
+        prior = last * pose2(*middle * std::cos(turn), *middle * std::sin(turn), turn);
+        spread = correlative_spread(current, reference, r.transform, config_.open_step_window,
+                                    kStepSpreadAngle, kStepSpreadResolution, o.search_fill_gap,
+                                    config_.open_step_margin, Eigen::Vector2d(prior.translation()));
+      }
       if (open_step && !stats_.long_search_won && spread.poses > 0)
-        r.transform = prior_along_open_direction(current, prepared, spread, r.transform, guess);
+        r.transform = prior_along_open_direction(current, prepared, spread, r.transform, prior);
     } else {
       r = register_scans(current, reference, o, guess);
       if (config_.constant_velocity && config_.open_step_window > 0.0 &&
@@ -271,6 +291,11 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   // Re-orthonormalise: chaining thousands of products slowly bends R off SO(2).
   pose = pose2(pose.translation().x(), pose.translation().y(), pose2_angle(pose));
   motion_ = pose_.inverse() * pose;
+  if (config_.open_step_speed_steps > 0) {
+    recent_step_lengths_.push_back(motion_.translation().norm());
+    if (recent_step_lengths_.size() > static_cast<std::size_t>(config_.open_step_speed_steps))
+      recent_step_lengths_.pop_front();
+  }
   motion_interval_ = interval;
   pose_ = pose;
   // For the map: deskewed by the motion into it (the best estimate of its own until the next).
