@@ -190,6 +190,9 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");
   v("submap_keyframes", o.submap_keyframes, nullptr,
     "the candidate's neighbours within this many keyframes join it for verification");
+  v("max_error_per_floor", o.max_error_per_floor, nullptr,
+    "A loop's pairing error may reach this many times the run's keyframe steps' lower quartile "
+    "(0: verification.max_error alone)");
   v("hessian_loop_information", o.hessian_loop_information, nullptr,
     "loop edges' information shaped by the match's Hessian (false: diagonal sigmas)");
   v("sliding_information_kept", o.sliding_information_kept, nullptr,

@@ -53,6 +53,8 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
         "rotation_open_sigma_theta must be positive");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
+  if (!(options.max_error_per_floor >= 0.0) || !std::isfinite(options.max_error_per_floor))
+    throw Error("loop closure: max_error_per_floor must be finite and not negative (0: off)");
   if (std::isnan(options.registration_reach))
     throw Error("loop closure: registration_reach must be a number (negative: off)");
   if (!(options.widening_per_weak_step >= 0.0) || !std::isfinite(options.widening_per_weak_step) ||
@@ -113,6 +115,8 @@ bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, boo
     } else {
       const Keyframe& previous = keyframes_.back();
       const Pose2 measurement = previous.odometry.inverse() * odometry;
+      k.pairing_error =
+          pairing_error_2d(scan, previous.points, measurement, options_.verification.pair_distance);
       k.path = previous.path + measurement.translation().norm();
       graph_.graph().add_node(graph().pose(index - 1) * measurement);
       graph_.graph().add_edge(index - 1, index, measurement, information->information,
@@ -168,6 +172,7 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
       keyframe, options_.skip_recent, graph(), places_, options_.candidates, 0, reach, proximity);
   counts_.ruled_out_by_estimate += found.ruled_out;
   const Pose2& here = graph().pose(keyframe);
+  const double max_error = loop_max_error();
   bool stale = false;
   // Each candidate's verification, prepared in order (the prepared references' cache is not
   // shared across threads), run side by side (each reads only its own reference, the shared
@@ -202,6 +207,7 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
     // The prepared scans do not depend on the window.
     LoopVerification2DOptions verification = options_.verification;
     verification.search_window *= doubt_widening(k, keyframe);
+    verification.max_error = max_error;
     if (!current) current.emplace(keyframes_[keyframe].points, options_.verification);
     tried.push_back({k, estimated, initial, prepared_reference(k, joined), verification, {}});
   }
@@ -273,6 +279,24 @@ std::shared_ptr<const LoopReference2D> LoopClosure2D::prepared_reference(
   if (prepared_.size() >= kPreparedReferences) prepared_.erase(prepared_.begin());
   prepared_.push_back(std::move(wanted));
   return prepared_.back().reference;
+}
+
+double LoopClosure2D::loop_max_error() const {
+  // The quieter quarter of the run's keyframe steps: turns (a rotating laser's scans distort) and
+  // clutter raise the rest. Not before 20 keyframes: the first few (a start among clutter, or
+  // turning) tell the sensor's floor badly.
+  constexpr double kQuantile = 0.25;
+  constexpr std::size_t kMinKeyframes = 20;
+  const double fixed = options_.verification.max_error;
+  if (!(options_.max_error_per_floor > 0.0)) return fixed;
+  std::vector<double> errors;
+  for (const Keyframe& k : keyframes_)
+    if (k.pairing_error >= 0.0) errors.push_back(k.pairing_error);
+  if (errors.size() < kMinKeyframes) return fixed;
+  const auto at =
+      errors.begin() + static_cast<std::ptrdiff_t>(kQuantile * static_cast<double>(errors.size()));
+  std::nth_element(errors.begin(), at, errors.end());
+  return std::max(fixed, options_.max_error_per_floor * *at);
 }
 
 double LoopClosure2D::doubt_widening(std::size_t older, std::size_t newer) const {

@@ -84,6 +84,14 @@ struct LoopClosure2DOptions {
   /// skipped recent ones) join its scan as the verification's reference (verify_loop_2d's
   /// candidate_neighbours). 0: scan against scan.
   std::size_t submap_keyframes = 6;
+  /// A loop's pairing error may reach this many times the run's own floor, where that exceeds
+  /// verification.max_error: the error of each keyframe paired onto the previous one at the
+  /// odometry's step, its lower quartile over the keyframes so far (from 20 on). Outdoors and in
+  /// large halls (long ranges, vegetation, clutter) true loops pair at 0.045-0.056 m: the fixed
+  /// 0.04 m rejected freiburg-campus's revisits of scans 200-350 (scores 0.8-0.9, 0.94 of the
+  /// points paired), and that section stayed 4-7 m off. The quartile: intel 0.014 m, room-2d
+  /// 0.015, ACES 0.023, fhw 0.026, freiburg-campus 0.027, acapulco 0.037. 0: the fixed bound.
+  double max_error_per_floor = 1.8;
   /// Loop edges hold what the match determines (its Hessian's shape at loop_sigma_xy), not the
   /// same certainty in every direction: a loop along a plain corridor holds nothing along it.
   bool hessian_loop_information = true;
@@ -229,6 +237,8 @@ class LoopClosure2D {
     double path = 0.0;           ///< m of odometry travel since the first keyframe
     std::size_t weak_steps = 0;  ///< weak-fit scans since the first scan
     bool rotation_open = false;  ///< the odometry edge from the previous keyframe is so
+    /// pairing_error_2d onto the previous keyframe at the odometry's step (negative: none).
+    double pairing_error = -1.0;
   };
   /// A scan since the last keyframe was registered with a weak fit (add_scan's weak_fit).
   bool weak_fit_since_keyframe_ = false;
@@ -236,6 +246,8 @@ class LoopClosure2D {
   /// How much wider the search between keyframe `newer` and an older one is
   /// (widening_per_weak_step).
   double doubt_widening(std::size_t older, std::size_t newer) const;
+  /// The verification's max_error for loops found now (max_error_per_floor).
+  double loop_max_error() const;
   /// Searches loops for the new keyframe, optimizes when they disagree with the estimate, and
   /// searches again for the keyframes before it when that moved the estimate far.
   void close_loops(std::size_t keyframe);

@@ -230,6 +230,16 @@ double paired_share(const Scan2D& from, const OverlapTarget& onto, const Pose2& 
 
 }  // namespace
 
+double pairing_error_2d(const Scan2D& from, const Scan2D& onto, const Pose2& T,
+                        double pair_distance) {
+  if (from.points.empty() || onto.points.empty() || !finite_scan(from) || !finite_scan(onto) ||
+      !T.matrix().allFinite())
+    return -1.0;
+  const OverlapCheck c = check_overlap(
+      from, OverlapTarget(onto, pair_distance, Registration2DOptions{}.search_fill_gap), T, 0.0);
+  return c.paired_fraction > 0.0 ? c.error : -1.0;
+}
+
 struct LoopCurrent2D::Impl {
   Impl(const Scan2D& s, double pair, double gap)
       : scan(s), finite(finite_scan(s)), pair_distance(pair), fill_gap(gap) {}

@@ -129,6 +129,11 @@ class LoopReference2D {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The mean distance (m) of `from`'s points moved by `T` to `onto`'s filled surfaces, over those
+/// within `pair_distance` (the verification's `error`, one way); negative when none pair.
+double pairing_error_2d(const Scan2D& from, const Scan2D& onto, const Pose2& T,
+                        double pair_distance);
+
 /// Verifies that `current` and `candidate` show the same place, starting from `initial` (current
 /// in the candidate's frame). Never throws for bad scans (too few or non-finite points): rejects.
 /// With `candidate_neighbours` (scans taken near the candidate, posed in its frame) the current
