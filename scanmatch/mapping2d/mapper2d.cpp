@@ -236,8 +236,6 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
       // The method failed from the search's pose (too few pairs after a turn, say) and the
       // search's pose was kept: it stands where it fits better than the motion prior would.
       search_pose_fits = r.search_pose_kept && best > fit(current, guess);
-      // The prior chooses along an open step only where it was not shown wrong by the long
-      // search.
       // After a turn the constant-velocity prior turns on: where the scans fit but leave the
       // length open and no fitting translation lies near that prior, straight on at the recent
       // speed (open_step_speed_steps).
@@ -257,6 +255,8 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
                                     kStepSpreadAngle, kStepSpreadResolution, o.search_fill_gap,
                                     config_.open_step_margin, Eigen::Vector2d(prior.translation()));
       }
+      // The prior chooses along an open step only where it was not shown wrong by the long
+      // search.
       if (open_step && !stats_.long_search_won && spread.poses > 0)
         r.transform = prior_along_open_direction(current, prepared, spread, r.transform, prior);
     } else {
