@@ -53,11 +53,10 @@ Scans2D room_scans(std::size_t count) {
   return load_scans_2d("sim:room-2d", o, count);
 }
 
-TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
-  // The simulated scans with an odometry that drifts in a known way: each step's true motion
-  // with a heading bias of 0.04 deg and 1 % too long. room-2d's rooms are identical and its hallway
-  // has doors every 5 m, so the drift is kept below the 2.5 m where those would alias.
-  const Scans2D input = room_scans(500);
+/// The scans' true poses and an odometry that drifts in a known way: each step's true motion
+/// with a heading bias of 0.04 deg and 1 % too long.
+std::pair<std::vector<Pose2>, std::vector<Pose2>> reference_and_drifting_odometry(
+    const Scans2D& input) {
   std::vector<Pose2> reference, odometry;
   for (std::size_t i = 0; i < input.scans.size(); ++i) {
     reference.push_back(pose2(input.scans[i].pose));
@@ -69,6 +68,15 @@ TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
       odometry.push_back(odometry.back() * step * pose2(0, 0, 0.04 * M_PI / 180));
     }
   }
+  return {reference, odometry};
+}
+
+TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
+  // The simulated scans with an odometry that drifts in a known way (1 % long, 0.04 deg a step).
+  // room-2d's rooms are identical and its hallway has doors every 5 m, so the drift is kept below
+  // the 2.5 m where those would alias.
+  const Scans2D input = room_scans(500);
+  const auto [reference, odometry] = reference_and_drifting_odometry(input);
   const auto close = [&](LoopClosure2D& loops) {
     for (std::size_t i = 0; i < input.scans.size(); ++i)
       loops.add_scan(scan_from_laser(input.scans[i], 0.05, 0.0, 0.0), odometry[i]);
@@ -140,21 +148,13 @@ TEST(LoopClosure2D, ANoisierSensorsTrueLoopsPairWithinItsOwnFloor) {
   // floor (its keyframe steps paired at the odometry) raises the bound to what this sensor
   // gives: more loops, a few of them off (room-2d's rooms are alike), and a closer map.
   const Scans2D input = room_scans(500);
+  const auto [reference, odometry] = reference_and_drifting_odometry(input);
   sim::Rng rng(7);
   std::vector<Scan2D> scans;
-  std::vector<Pose2> reference, odometry;
-  for (std::size_t i = 0; i < input.scans.size(); ++i) {
-    Scan2D scan = scan_from_laser(input.scans[i], 0.05, 0.0, 0.0);
+  for (const LaserScan2D& laser : input.scans) {
+    Scan2D scan = scan_from_laser(laser, 0.05, 0.0, 0.0);
     for (Eigen::Vector2d& p : scan.points) p += 0.08 * rng.normal() * p.normalized();
     scans.push_back(std::move(scan));
-    reference.push_back(pose2(input.scans[i].pose));
-    if (i == 0) {
-      odometry.push_back(Pose2::Identity());
-    } else {
-      Pose2 step = reference[i - 1].inverse() * reference[i];
-      step.translation() *= 1.01;
-      odometry.push_back(odometry.back() * step * pose2(0, 0, 0.04 * M_PI / 180));
-    }
   }
   const auto close = [&](const LoopClosure2DOptions& options) {
     LoopClosure2D loops(options);
