@@ -170,17 +170,20 @@ TEST(LoopClosure2D, ANoisierSensorsTrueLoopsPairWithinItsOwnFloor) {
       wrong += error.translation().norm() > 0.3;
     }
     return std::tuple(loops.counts().verified, wrong,
-                      absolute_trajectory_error_2d(reference, loops.poses()).rmse);
+                      absolute_trajectory_error_2d(reference, loops.poses()).rmse,
+                      loops.counts().max_error_m);
   };
   LoopClosure2DOptions fixed;
   fixed.max_error_per_floor = 0.0;
-  const auto [verified_fixed, wrong_fixed, ate_fixed] = close(fixed);
-  const auto [verified, wrong, ate] = close(LoopClosure2DOptions{});
+  const auto [verified_fixed, wrong_fixed, ate_fixed, bound_fixed] = close(fixed);
+  const auto [verified, wrong, ate, bound] = close(LoopClosure2DOptions{});
   const double drift = absolute_trajectory_error_2d(reference, odometry).rmse;
   std::printf(
       "room-2d, 8 cm beam noise: %zu loops (%d off by > 0.3 m) with the fixed bound, %zu (%d) "
-      "with the run's floor; ATE %.3f / %.3f m (odometry %.3f)\n",
-      verified_fixed, wrong_fixed, verified, wrong, ate_fixed, ate, drift);
+      "with the run's floor (%.3f m); ATE %.3f / %.3f m (odometry %.3f)\n",
+      verified_fixed, wrong_fixed, verified, wrong, bound, ate_fixed, ate, drift);
+  EXPECT_EQ(bound_fixed, LoopVerification2DOptions{}.max_error);
+  EXPECT_GT(bound, bound_fixed);
   EXPECT_GT(verified, verified_fixed + verified_fixed / 10);
   EXPECT_LE(wrong, static_cast<int>(verified / 20));
   EXPECT_LT(ate, 0.25 * drift);

@@ -173,6 +173,7 @@ bool LoopClosure2D::search_loops(std::size_t keyframe) {
   counts_.ruled_out_by_estimate += found.ruled_out;
   const Pose2& here = graph().pose(keyframe);
   const double max_error = loop_max_error();
+  counts_.max_error_m = max_error;
   bool stale = false;
   // Each candidate's verification, prepared in order (the prepared references' cache is not
   // shared across threads), run side by side (each reads only its own reference, the shared

@@ -194,6 +194,9 @@ struct LoopClosure2DCounts {
   /// Of the verified loops, those the estimate check let through only by turning the keyframes
   /// after a rotation-open step.
   std::size_t turned_at_open_rotation = 0;
+  /// The pairing error a loop could have at most when the last keyframe looked for loops
+  /// (verification.max_error, raised by max_error_per_floor), m.
+  double max_error_m = 0.0;
   double total_ms = 0.0;  ///< wall time spent in add_scan() and finish()
 };
 

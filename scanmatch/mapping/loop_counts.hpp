@@ -43,6 +43,9 @@ void describe(Counts& c, Visitor& v) {
     "rotation-open step");
   v("ruled_out_by_estimate", c.ruled_out_by_estimate,
     "place-database matches ruled out before verification (registration_reach); not candidates");
+  v("max_error_m", c.max_error_m,
+    "a loop's pairing error at most, at the last search (max_error, raised by "
+    "max_error_per_floor), m");
   v("total_ms", c.total_ms, "wall time spent in add_scan() and finish(), ms");
 }
 
