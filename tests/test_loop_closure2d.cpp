@@ -142,6 +142,24 @@ TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
     EXPECT_TRUE(all[i].matrix() == optimized[i].matrix()) << "scan " << i;
 }
 
+TEST(LoopClosure2D, PairingErrorIsTheMeanDistanceOfThePairedPoints) {
+  const Scan2D scan = half_scan(room_walls(), pose2(0.0, 0.0, 0.0));
+  ASSERT_GT(scan.points.size(), 100u);
+  EXPECT_NEAR(pairing_error_2d(scan, scan, Pose2::Identity(), 0.1), 0.0, 1e-9);
+  // Moved 3 cm towards +x, the points of the wall ahead (x = 4) lie 3 cm from it; every other
+  // wall slides along itself or moves 3 cm too: the mean is at most 3 cm and well above 1 cm.
+  const double moved = pairing_error_2d(scan, scan, pose2(0.03, 0.0, 0.0), 0.1);
+  EXPECT_GT(moved, 0.01);
+  EXPECT_LE(moved, 0.03 + 1e-9);
+  // Nothing pairs 50 m away; bad input gives no error rather than a number.
+  EXPECT_LT(pairing_error_2d(scan, scan, pose2(50.0, 50.0, 0.0), 0.1), 0.0);
+  EXPECT_LT(pairing_error_2d(Scan2D{}, scan, Pose2::Identity(), 0.1), 0.0);
+  Scan2D bad = scan;
+  bad.points[3].x() = std::nan("");
+  EXPECT_LT(pairing_error_2d(bad, scan, Pose2::Identity(), 0.1), 0.0);
+  EXPECT_LT(pairing_error_2d(scan, bad, Pose2::Identity(), 0.1), 0.0);
+}
+
 TEST(LoopClosure2D, ANoisierSensorsTrueLoopsPairWithinItsOwnFloor) {
   // A laser much noisier than the fixed bound assumes (8 cm along each beam): many true loops pair
   // at more than verification.max_error's 4 cm and the fixed bound rejects them. The run's own

@@ -219,12 +219,28 @@ OverlapCheck check_overlap(const Scan2D& from, const OverlapTarget& onto, const 
   return c;
 }
 
-// check_overlap's paired_fraction alone: the slid scans of the shift test leave most points
-// unpaired, and looking each up in the free space of every joined view was most of that test.
-double paired_share(const Scan2D& from, const OverlapTarget& onto, const Pose2& T) {
+// check_overlap's pairing alone (how many of `from`'s points moved by `T` pair, and their
+// distances' sum), without its free space and normals: the slid scans of the shift test leave
+// most points unpaired, and looking each up in the free space of every joined view was most of
+// that test.
+struct Pairing {
   std::size_t paired = 0;
-  for (const Eigen::Vector2d& p : from.points) paired += onto.hash.nearest(T * p) >= 0.0;
-  return static_cast<double>(paired) /
+  double distance_sum = 0.0;
+};
+Pairing pair_onto(const Scan2D& from, const PointHash& onto, const Pose2& T) {
+  Pairing out;
+  for (const Eigen::Vector2d& p : from.points) {
+    const double d = onto.nearest(T * p);
+    if (d >= 0.0) {
+      ++out.paired;
+      out.distance_sum += d;
+    }
+  }
+  return out;
+}
+
+double paired_share(const Scan2D& from, const OverlapTarget& onto, const Pose2& T) {
+  return static_cast<double>(pair_onto(from, onto.hash, T).paired) /
          static_cast<double>(std::max<std::size_t>(from.points.size(), 1));
 }
 
@@ -235,9 +251,12 @@ double pairing_error_2d(const Scan2D& from, const Scan2D& onto, const Pose2& T,
   if (from.points.empty() || onto.points.empty() || !finite_scan(from) || !finite_scan(onto) ||
       !T.matrix().allFinite())
     return -1.0;
-  const OverlapCheck c = check_overlap(
-      from, OverlapTarget(onto, pair_distance, Registration2DOptions{}.search_fill_gap), T, 0.0);
-  return c.paired_fraction > 0.0 ? c.error : -1.0;
+  // The surfaces as OverlapTarget fills them; no free space is needed here.
+  const PointHash surfaces(
+      filled_surfaces(onto, Registration2DOptions{}.search_fill_gap, 0.5 * pair_distance),
+      pair_distance);
+  const Pairing p = pair_onto(from, surfaces, T);
+  return p.paired > 0 ? p.distance_sum / static_cast<double>(p.paired) : -1.0;
 }
 
 struct LoopCurrent2D::Impl {
