@@ -564,6 +564,15 @@ TEST(LoopClosure2D, ATurnInARoundRoomLeavesTheRotationOpen) {
   EXPECT_GE(round_ratio, options.rotation_open_ratio);
   EXPECT_LT(walled_ratio, 0.75);
   EXPECT_EQ(rotation_ambiguity_2d(Scan2D{}, walled_before, step), 0.0);  // nothing to score
+  // Asked only for ratios reaching a threshold, the far search ends early: the ratio is the same
+  // where it reaches it (also exactly at it), and below it where it does not.
+  EXPECT_EQ(rotation_ambiguity_2d(round_after, round_before, step, 0.5, 0.9), round_ratio);
+  EXPECT_EQ(rotation_ambiguity_2d(round_after, round_before, step, 0.5, round_ratio), round_ratio);
+  EXPECT_EQ(rotation_ambiguity_2d(walled_after, walled_before, step, 0.5, walled_ratio),
+            walled_ratio);
+  EXPECT_LT(rotation_ambiguity_2d(walled_after, walled_before, step, 0.5, 0.9), 0.9);
+  EXPECT_LT(rotation_ambiguity_2d(walled_after, walled_before, step, 0.5, walled_ratio + 0.05),
+            walled_ratio + 0.05);
 
   const auto edge_rotation_information = [&](const Scan2D& before, const Scan2D& after,
                                              const LoopClosure2DOptions& o) {

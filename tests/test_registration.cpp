@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <random>
 
@@ -9,6 +11,7 @@
 #include "scanmatch/geometry/covariance.hpp"
 #include "scanmatch/geometry/gaussian_voxel_map.hpp"
 #include "scanmatch/geometry/kdtree.hpp"
+#include "scanmatch/geometry/point_grid2.hpp"
 #include "scanmatch/geometry/voxel_filter.hpp"
 #include "scanmatch/io/cloud_io.hpp"
 #include "scanmatch/registration/methods.hpp"
@@ -211,6 +214,66 @@ TEST(Geometry, KdTreeMatchesBruteForce) {
   std::size_t index;
   float d2;
   EXPECT_FALSE(tree.nearest(Point(100, 100, 100), 1.0f, index, d2));
+}
+
+TEST(Geometry, PointGrid2FindsWhatABruteForceSearchFinds) {
+  // Clustered walls and scattered points, queries on and off the grid, radii from a few cm to
+  // several cells: the nearest within the radius, exactly, and of equally near points the first.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-12, 12), small(-0.05, 0.05);
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 1500; ++i) points.emplace_back(u(rng), 3.0 + small(rng));  // a wall
+  for (int i = 0; i < 500; ++i) points.emplace_back(u(rng), u(rng));
+  points.push_back(points[10]);  // a duplicate: the first of the two is the answer
+  points.emplace_back(std::nan(""), 1.0);
+  points.emplace_back(1.0, std::numeric_limits<double>::infinity());
+  const PointGrid2 grid(points, 0.2);
+  EXPECT_EQ(grid.size(), points.size() - 2);  // the non-finite ones are not indexed
+  const auto brute = [&](const Eigen::Vector2d& q, double max_squared) {
+    std::optional<std::size_t> best;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!points[i].allFinite()) continue;
+      const double d = (points[i] - q).squaredNorm();
+      if (d <= max_squared && (!best || d < (points[*best] - q).squaredNorm())) best = i;
+    }
+    return best;
+  };
+  std::uniform_real_distribution<double> far(-20, 20);
+  std::size_t found = 0;
+  for (int q = 0; q < 3000; ++q) {
+    const Eigen::Vector2d query(far(rng), q % 3 == 0 ? 3.0 + far(rng) * 0.02 : far(rng));
+    for (const double radius : {0.05, 0.3, 1.2, 5.0}) {
+      const std::optional<std::size_t> expected = brute(query, radius * radius);
+      std::size_t index = 0;
+      double squared = -1.0;
+      const bool hit = grid.nearest(query, radius * radius, index, squared);
+      ASSERT_EQ(hit, expected.has_value()) << query.transpose() << " within " << radius;
+      if (!hit) continue;
+      ++found;
+      EXPECT_EQ(index, *expected);
+      EXPECT_EQ(squared, (points[index] - query).squaredNorm());
+    }
+  }
+  EXPECT_GT(found, 3000u);  // the radii found something often, and missed often
+  std::size_t index = 0;
+  double squared = 0.0;
+  ASSERT_TRUE(grid.nearest(points[10], 0.01, index, squared));
+  EXPECT_EQ(index, 10u);
+  EXPECT_EQ(squared, 0.0);
+  EXPECT_FALSE(grid.nearest(Eigen::Vector2d(1e6, -1e6), 4.0, index, squared));
+  EXPECT_FALSE(grid.nearest(Eigen::Vector2d(std::nan(""), 0.0), 4.0, index, squared));
+
+  // A stray return kilometres away coarsens the cells, and the answers stay exact.
+  std::vector<Eigen::Vector2d> stray = {{0.0, 0.0}, {0.3, 0.1}, {4e3, -3e3}};
+  const PointGrid2 coarse(stray, 0.2);
+  EXPECT_GT(coarse.cell(), 0.2);
+  ASSERT_TRUE(coarse.nearest(Eigen::Vector2d(0.25, 0.0), 1.0, index, squared));
+  EXPECT_EQ(index, 1u);
+  ASSERT_TRUE(coarse.nearest(Eigen::Vector2d(4e3, -3e3 + 0.5), 1.0, index, squared));
+  EXPECT_EQ(index, 2u);
+  EXPECT_FALSE(PointGrid2({}, 0.2).nearest(Eigen::Vector2d::Zero(), 1.0, index, squared));
+  EXPECT_THROW(PointGrid2(stray, 0.0), Error);
+  EXPECT_THROW(PointGrid2(stray, std::nan("")), Error);
 }
 
 TEST(Geometry, KdTree2MatchesBruteForce) {

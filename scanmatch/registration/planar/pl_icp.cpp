@@ -19,7 +19,7 @@ Registration2DResult run_pl_icp(const Scan2D& current, const Reference2D& prepar
                                 const Registration2DOptions& o, const Pose2& initial) {
   using Vec2 = Eigen::Vector2d;
   const Scan2D& reference = prepared.scan();
-  const KdTree2& tree = prepared.tree();
+  const PointGrid2& tree = prepared.grid();
   const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
   const std::vector<FittedLine> no_lines;
   const std::vector<FittedLine>& lines =

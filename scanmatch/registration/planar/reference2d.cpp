@@ -8,6 +8,14 @@ const KdTree2& Reference2D::tree() const {
   return *tree_;
 }
 
+const PointGrid2& Reference2D::grid() const {
+  // Cells of 0.2 m: a laser's pairs lie within a few cm, found in the 3 x 3 cells about the query.
+  constexpr double kCell = 0.2;
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!grid_) grid_.emplace(scan_.points, kCell);
+  return *grid_;
+}
+
 const std::vector<FittedLine>& Reference2D::lines(double radius, double max_gap) const {
   const std::lock_guard<std::mutex> lock(mutex_);
   for (const auto& l : lines_)

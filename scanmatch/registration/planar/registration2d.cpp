@@ -112,7 +112,7 @@ class SurfaceDistance {
   double operator()(const Scan2D& current, const Pose2& pose) const {
     if (current.points.empty() || reference_.scan().points.empty()) return cap_;
     const double radius = cap_ + max_gap_;
-    const KdTree2& tree = reference_.tree();  // once: each call takes the reference's lock
+    const PointGrid2& tree = reference_.grid();  // once: each call takes the reference's lock
     double sum = 0.0;
     for (const Eigen::Vector2d& p : current.points) {
       const Eigen::Vector2d q = pose * p;

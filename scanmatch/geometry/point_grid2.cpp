@@ -1,0 +1,106 @@
+#include "scanmatch/geometry/point_grid2.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "scanmatch/core/error.hpp"
+
+namespace scanmatch {
+namespace {
+// Cells at most: a scan's stray far return must not make the grid huge (the cells coarsen).
+constexpr double kMaxCells = 4e6;
+}  // namespace
+
+PointGrid2::PointGrid2(const std::vector<Eigen::Vector2d>& points, double cell) : cell_(cell) {
+  if (!(cell > 0.0) || !std::isfinite(cell))
+    throw Error("point grid: the cell size must be positive and finite");
+  if (points.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw Error("point grid: too many points");
+  Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d high = -low;
+  for (const Eigen::Vector2d& p : points) {
+    if (!p.allFinite()) continue;
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+    ++size_;
+  }
+  if (size_ == 0) return;
+  const Eigen::Vector2d extent = high - low;
+  const auto cells = [&](double c) { return (extent.x() / c + 1) * (extent.y() / c + 1); };
+  while (cells(cell_) > kMaxCells) cell_ *= 2;
+  origin_ = low;
+  width_ = static_cast<long>(extent.x() / cell_) + 1;
+  height_ = static_cast<long>(extent.y() / cell_) + 1;
+  const auto cell_of = [&](const Eigen::Vector2d& p) {
+    const long x = std::min(static_cast<long>((p.x() - low.x()) / cell_), width_ - 1);
+    const long y = std::min(static_cast<long>((p.y() - low.y()) / cell_), height_ - 1);
+    return static_cast<std::size_t>(y * width_ + x);
+  };
+  // Counting sort by cell, stable: each cell's points keep their input order.
+  cell_start_.assign(static_cast<std::size_t>(width_ * height_) + 1, 0);
+  for (const Eigen::Vector2d& p : points)
+    if (p.allFinite()) ++cell_start_[cell_of(p) + 1];
+  for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
+  std::vector<std::uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
+  sorted_.resize(size_);
+  index_.resize(size_);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) continue;
+    const std::uint32_t at = next[cell_of(points[i])]++;
+    sorted_[at] = points[i];
+    index_[at] = static_cast<std::uint32_t>(i);
+  }
+}
+
+bool PointGrid2::nearest(const Eigen::Vector2d& query, double max_squared_distance,
+                         std::size_t& index, double& squared_distance) const {
+  if (size_ == 0 || !query.allFinite() || !(max_squared_distance >= 0.0)) return false;
+  const double radius = std::sqrt(max_squared_distance);
+  // The query's cell, possibly off the grid; clamped so that a far query cannot overflow.
+  const auto cell_index = [&](double v, double low, long cells) {
+    const double c = std::floor((v - low) / cell_);
+    return static_cast<long>(std::clamp(c, -1.0 - radius / cell_ - 1.0,
+                                        static_cast<double>(cells) + radius / cell_ + 1.0));
+  };
+  const long qx = cell_index(query.x(), origin_.x(), width_);
+  const long qy = cell_index(query.y(), origin_.y(), height_);
+  double best = std::numeric_limits<double>::infinity();
+  std::uint32_t best_index = 0;
+  const auto visit = [&](long x, long y) {
+    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+    const auto c = static_cast<std::size_t>(y * width_ + x);
+    for (std::uint32_t i = cell_start_[c]; i < cell_start_[c + 1]; ++i) {
+      const double d = (sorted_[i] - query).squaredNorm();
+      if (d < best || (d == best && index_[i] < best_index)) {
+        best = d;
+        best_index = index_[i];
+      }
+    }
+  };
+  // Ring k holds the cells k away (Chebyshev) from the query's; the points of ring k + 1 and
+  // beyond lie at least k cells away, so once the best is nearer than that it is the nearest.
+  const long rings = static_cast<long>(std::ceil(radius / cell_)) + 1;
+  for (long k = 0; k <= rings; ++k) {
+    if (k == 0) {
+      visit(qx, qy);
+    } else {
+      for (long dx = -k; dx <= k; ++dx) {
+        visit(qx + dx, qy - k);
+        visit(qx + dx, qy + k);
+      }
+      for (long dy = -k + 1; dy <= k - 1; ++dy) {
+        visit(qx - k, qy + dy);
+        visit(qx + k, qy + dy);
+      }
+    }
+    const double reach = static_cast<double>(k) * cell_;
+    if (best < reach * reach || reach > radius) break;
+  }
+  if (!(best <= max_squared_distance)) return false;
+  index = best_index;
+  squared_distance = best;
+  return true;
+}
+
+}  // namespace scanmatch
