@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -140,6 +142,55 @@ TEST(LoopClosure2D, ReducesTheErrorOfASimulatedSequence) {
   const std::vector<Pose2> all = unfiltered.poses();
   for (std::size_t i = 0; i < all.size(); ++i)
     EXPECT_TRUE(all[i].matrix() == optimized[i].matrix()) << "scan " << i;
+}
+
+TEST(LoopClosure2D, KeyframeStepsMadeAheadCloseTheSameLoops) {
+  // The keyframe steps depend on the odometry alone: made for the whole run before the graph sees
+  // any of them (as a run makes them on the odometry's thread), they give the same keyframes,
+  // loops and poses as add_scan, to the bit; also past a non-finite odometry pose and weak fits.
+  const Scans2D input = room_scans(300);
+  auto [reference, odometry] = reference_and_drifting_odometry(input);
+  odometry[57].translation().x() = std::numeric_limits<double>::quiet_NaN();
+  const auto weak = [](std::size_t i) { return i % 23 == 5; };
+  std::vector<Scan2D> scans;
+  for (const LaserScan2D& laser : input.scans)
+    scans.push_back(scan_from_laser(laser, 0.05, 0.0, 0.0));
+  LoopClosure2D inline_steps;
+  for (std::size_t i = 0; i < scans.size(); ++i)
+    inline_steps.add_scan(scans[i], odometry[i], weak(i));
+  inline_steps.finish();
+  LoopKeyframes2D keyframes;
+  std::vector<KeyframeStep2D> steps;
+  for (std::size_t i = 0; i < scans.size(); ++i)
+    steps.push_back(keyframes.add_scan(scans[i], odometry[i], weak(i)));
+  LoopClosure2D ahead;
+  std::size_t keyframe_steps = 0;
+  for (std::size_t i = 0; i < scans.size(); ++i)
+    keyframe_steps += ahead.add_step(scans[i], steps[i]);
+  ahead.finish();
+  const LoopClosure2DCounts &a = inline_steps.counts(), &b = ahead.counts();
+  EXPECT_EQ(keyframe_steps, a.keyframes);
+  EXPECT_EQ(b.keyframes, a.keyframes);
+  EXPECT_EQ(b.candidates, a.candidates);
+  EXPECT_EQ(b.verified, a.verified);
+  EXPECT_EQ(b.open_odometry_edges, a.open_odometry_edges);
+  EXPECT_EQ(b.rotation_open_odometry_edges, a.rotation_open_odometry_edges);
+  EXPECT_GT(a.verified, 0u);
+  ASSERT_EQ(ahead.loops().size(), inline_steps.loops().size());
+  for (std::size_t i = 0; i < ahead.loops().size(); ++i)
+    EXPECT_TRUE(ahead.loops()[i].relative.matrix() == inline_steps.loops()[i].relative.matrix());
+  const std::vector<Pose2> p = ahead.poses(), q = inline_steps.poses();
+  ASSERT_EQ(p.size(), scans.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_TRUE(p[i].matrix().allFinite()) << "scan " << i;
+    EXPECT_TRUE(p[i].matrix() == q[i].matrix()) << "scan " << i;
+  }
+  // A run whose first step is not a keyframe's was fed steps from another run: refused.
+  const auto not_keyframe =
+      std::find_if(steps.begin(), steps.end(), [](const KeyframeStep2D& k) { return !k.keyframe; });
+  ASSERT_NE(not_keyframe, steps.end());
+  LoopClosure2D fresh;
+  EXPECT_THROW(fresh.add_step(scans[0], *not_keyframe), Error);
 }
 
 TEST(LoopClosure2D, PairingErrorIsTheMeanDistanceOfThePairedPoints) {

@@ -28,8 +28,7 @@ double moved_at_5m(const Pose2& change) {
 
 }  // namespace
 
-LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
-    : options_(options), graph_(options.graph) {
+void check_loop_closure_2d_options(const LoopClosure2DOptions& options) {
   check_registration_2d_method(options.verification.method);
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(options.odometry_sigma_xy) || !positive(options.odometry_sigma_theta) ||
@@ -71,71 +70,104 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
     throw Error("loop closure: max_shifted_fraction must not be negative (0: not checked)");
   if (!(options.sliding_information_kept >= 0.0 && options.sliding_information_kept <= 1.0))
     throw Error("loop closure: sliding_information_kept must be in [0, 1]");
+}
+
+LoopKeyframes2D::LoopKeyframes2D(const LoopClosure2DOptions& options) : options_(options) {
+  check_loop_closure_2d_options(options);
+}
+
+KeyframeStep2D LoopKeyframes2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose,
+                                         bool weak_fit) {
+  const Stopwatch stopwatch;
+  weak_fit_since_keyframe_ = weak_fit_since_keyframe_ || weak_fit;
+  weak_steps_ += weak_fit;
+  KeyframeStep2D step;
+  // A non-finite odometry pose would poison the graph: hold the last one instead.
+  step.odometry = odometry_pose;
+  if (!step.odometry.matrix().allFinite())
+    step.odometry = have_keyframe_ ? keyframe_odometry_ * last_offset_ : Pose2::Identity();
+  step.keyframe = !have_keyframe_;
+  std::optional<OdometryInformation> information;
+  if (have_keyframe_) {
+    step.measurement = keyframe_odometry_.inverse() * step.odometry;
+    const Pose2& motion = step.measurement;
+    step.keyframe = motion.translation().norm() >= options_.keyframe_distance ||
+                    std::abs(pose2_angle(motion)) >= options_.keyframe_angle;
+    // A scan whose step the scans leave open becomes a keyframe however little the odometry
+    // moved: a slid step is short, and only a node of its own lets the graph stretch it back.
+    if (step.keyframe ||
+        (options_.odometry_spread_window > 0.0 && options_.open_steps_are_keyframes)) {
+      information = odometry_information(keyframe_points_, scan, motion);
+      step.keyframe = step.keyframe || information->open;
+    }
+    // Only keyframe steps: the rotation test searches 160 degrees.
+    if (step.keyframe) {
+      loosen_open_rotation(*information, keyframe_points_, scan, motion, weak_fit_since_keyframe_);
+      step.information = information->information;
+      step.open = information->open;
+      step.rotation_open = information->rotation_open;
+      step.pairing_error = pairing_error_2d(scan, keyframe_points_, step.measurement,
+                                            options_.verification.pair_distance);
+    }
+  }
+  if (step.keyframe) {
+    step.weak_steps = weak_steps_;
+    step.descriptor = make_place_descriptor(scan, options_.descriptor);
+    keyframe_points_ = scan;
+    keyframe_odometry_ = step.odometry;
+    have_keyframe_ = true;
+    weak_fit_since_keyframe_ = false;
+  }
+  last_offset_ = keyframe_odometry_.inverse() * step.odometry;
+  step.offset = last_offset_;
+  step.ms = stopwatch.ms();
+  return step;
+}
+
+LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
+    : options_(options), graph_(options.graph), keyframer_(options) {
   options_.search_every = std::max<std::size_t>(options_.search_every, 1);
 }
 
 bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, bool weak_fit) {
+  return add_step(scan, keyframer_.add_scan(scan, odometry_pose, weak_fit));
+}
+
+bool LoopClosure2D::add_step(const Scan2D& scan, const KeyframeStep2D& step) {
   const Stopwatch stopwatch;
-  weak_fit_since_keyframe_ = weak_fit_since_keyframe_ || weak_fit;
-  weak_steps_ += weak_fit;
-  // A non-finite odometry pose would poison the graph: hold the last one instead.
-  Pose2 odometry = odometry_pose;
-  if (!odometry.matrix().allFinite())
-    odometry = keyframes_.empty()
-                   ? Pose2::Identity()
-                   : keyframes_.back().odometry * graph_.offset_in_keyframe(scans() - 1);
-  bool new_keyframe = keyframes_.empty();
-  std::optional<OdometryInformation> information;
-  if (!new_keyframe) {
-    const Pose2 motion = keyframes_.back().odometry.inverse() * odometry;
-    new_keyframe = motion.translation().norm() >= options_.keyframe_distance ||
-                   std::abs(pose2_angle(motion)) >= options_.keyframe_angle;
-    // A scan whose step the scans leave open becomes a keyframe however little the odometry
-    // moved: a slid step is short, and only a node of its own lets the graph stretch it back.
-    if (new_keyframe ||
-        (options_.odometry_spread_window > 0.0 && options_.open_steps_are_keyframes)) {
-      information = odometry_information(keyframes_.back().points, scan, motion);
-      new_keyframe = new_keyframe || information->open;
-    }
-    // Only keyframe steps: the rotation test searches 160 degrees.
-    if (new_keyframe)
-      loosen_open_rotation(*information, keyframes_.back().points, scan, motion,
-                           weak_fit_since_keyframe_);
-  }
-  if (new_keyframe) {
+  if (keyframes_.empty() && !step.keyframe)
+    throw Error("loop closure: the first scan's step must make it a keyframe");
+  if (step.keyframe) {
     Keyframe k;
     k.scan = scans();
     k.points = scan;
-    k.odometry = odometry;
-    k.weak_steps = weak_steps_;
+    k.odometry = step.odometry;
+    k.weak_steps = step.weak_steps;
     const std::size_t index = keyframes_.size();
     if (index == 0) {
-      graph_.graph().add_node(odometry);
+      graph_.graph().add_node(step.odometry);
       keyframes_.push_back(std::move(k));
     } else {
       const Keyframe& previous = keyframes_.back();
-      const Pose2 measurement = previous.odometry.inverse() * odometry;
-      k.pairing_error =
-          pairing_error_2d(scan, previous.points, measurement, options_.verification.pair_distance);
-      k.path = previous.path + measurement.translation().norm();
-      graph_.graph().add_node(graph().pose(index - 1) * measurement);
-      graph_.graph().add_edge(index - 1, index, measurement, information->information,
+      k.pairing_error = step.pairing_error;
+      k.path = previous.path + step.measurement.translation().norm();
+      graph_.graph().add_node(graph().pose(index - 1) * step.measurement);
+      graph_.graph().add_edge(index - 1, index, step.measurement, step.information,
                               EdgeKind::kOdometry);
-      if (information->open) ++counts_.open_odometry_edges;
-      k.rotation_open = information->rotation_open;
+      if (step.open) ++counts_.open_odometry_edges;
+      k.rotation_open = step.rotation_open;
       if (k.rotation_open) ++counts_.rotation_open_odometry_edges;
       keyframes_.push_back(std::move(k));
     }
-    weak_fit_since_keyframe_ = false;
-    places_.add(make_place_descriptor(scan, options_.descriptor));
+    places_.add(step.descriptor);
     ++counts_.keyframes;
     const bool pausing =
         !loops().empty() && index <= last_loop_keyframe_ + options_.keyframes_between_loops;
     if (index % options_.search_every == 0 && !pausing) close_loops(index);
   }
-  graph_.add_frame(keyframes_.size() - 1, keyframes_.back().odometry.inverse() * odometry);
-  counts_.total_ms += stopwatch.ms();
-  return new_keyframe;
+  graph_.add_frame(keyframes_.size() - 1, step.offset);
+  counts_.total_ms += step.ms + stopwatch.ms();
+  return step.keyframe;
 }
 
 void LoopClosure2D::close_loops(std::size_t keyframe) {
@@ -355,7 +387,7 @@ double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
   }
 }
 
-LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
+LoopKeyframes2D::OdometryInformation LoopKeyframes2D::odometry_information(
     const Scan2D& previous, const Scan2D& current, const Pose2& measurement) const {
   OdometryInformation out;
   out.information =
@@ -375,9 +407,9 @@ LoopClosure2D::OdometryInformation LoopClosure2D::odometry_information(
   return out;
 }
 
-void LoopClosure2D::loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
-                                         const Scan2D& current, const Pose2& measurement,
-                                         bool weak_fit) const {
+void LoopKeyframes2D::loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
+                                           const Scan2D& current, const Pose2& measurement,
+                                           bool weak_fit) const {
   if (!(options_.rotation_open_ratio > 0.0) ||
       (!weak_fit && std::abs(pose2_angle(measurement)) < options_.rotation_open_min_turn) ||
       rotation_ambiguity_2d(current, previous, measurement, 0.5, options_.rotation_open_ratio) <

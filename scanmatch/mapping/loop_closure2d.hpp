@@ -197,7 +197,8 @@ struct LoopClosure2DCounts {
   /// The pairing error a loop could have at most when the last keyframe looked for loops
   /// (verification.max_error, raised by max_error_per_floor), m.
   double max_error_m = 0.0;
-  double total_ms = 0.0;  ///< wall time spent in add_scan() and finish()
+  /// Wall time spent in add_scan() (or add_step() and making its steps) and finish().
+  double total_ms = 0.0;
 };
 
 /// How well the best rotation 10-90 degrees off the step `measurement` (current in the previous
@@ -211,6 +212,63 @@ struct LoopClosure2DCounts {
 double rotation_ambiguity_2d(const Scan2D& current, const Scan2D& previous,
                              const Pose2& measurement, double window = 0.5, double at_least = 0.0);
 
+/// Throws Error naming the problem for an unknown registration method or options out of range.
+void check_loop_closure_2d_options(const LoopClosure2DOptions& options);
+
+/// What loop closure makes of one scan from the odometry alone, before the graph: whether the scan
+/// becomes a keyframe and, for a keyframe after the first, its odometry edge and pairing floor.
+struct KeyframeStep2D {
+  Pose2 odometry = Pose2::Identity();  ///< the scan's odometry pose (non-finite: the last one)
+  Pose2 offset = Pose2::Identity();    ///< in the frame of its keyframe (itself, if one)
+  bool keyframe = false;
+  // A keyframe after the first:
+  Pose2 measurement = Pose2::Identity();                  ///< from the previous keyframe
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  ///< of its odometry edge
+  bool open = false;            ///< the scans leave the step open (open_step_spread)
+  bool rotation_open = false;   ///< the scans leave its rotation open (rotation_open_ratio)
+  double pairing_error = -1.0;  ///< pairing_error_2d onto the previous keyframe (negative: none)
+  // A keyframe:
+  std::size_t weak_steps = 0;  ///< weak-fit scans since the first scan
+  PlaceDescriptor2D descriptor;
+  double ms = 0.0;  ///< the time it took
+};
+
+/// The odometry's side of LoopClosure2D: keyframes and their odometry edges depend on the
+/// odometry's poses and scans alone, so a run makes them on the odometry's thread (which waits
+/// for loop closure's on intel) and hands them over with the scans (LoopClosure2D::add_step).
+class LoopKeyframes2D {
+ public:
+  /// Throws Error for options out of range (check_loop_closure_2d_options).
+  explicit LoopKeyframes2D(const LoopClosure2DOptions& options = {});
+  /// The next scan, as LoopClosure2D::add_scan takes it.
+  KeyframeStep2D add_scan(const Scan2D& scan, const Pose2& odometry_pose, bool weak_fit = false);
+
+ private:
+  struct OdometryInformation {
+    Eigen::Matrix3d information;
+    bool open = false;
+    bool rotation_open = false;
+  };
+  /// The information of an odometry edge from `previous` to `current`, which the odometry put at
+  /// `measurement` (current in previous's frame).
+  OdometryInformation odometry_information(const Scan2D& previous, const Scan2D& current,
+                                           const Pose2& measurement) const;
+  /// Marks a keyframe step rotation-open (rotation_open_ratio, for steps that turn at least
+  /// rotation_open_min_turn or hold a weak fit) and loosens its edge's rotation to
+  /// rotation_open_sigma_theta.
+  void loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
+                            const Scan2D& current, const Pose2& measurement, bool weak_fit) const;
+
+  LoopClosure2DOptions options_;
+  bool have_keyframe_ = false;
+  Scan2D keyframe_points_;  ///< the last keyframe's scan
+  Pose2 keyframe_odometry_ = Pose2::Identity();
+  Pose2 last_offset_ = Pose2::Identity();  ///< the last scan's, in its keyframe's frame
+  /// A scan since the last keyframe was registered with a weak fit (add_scan's weak_fit).
+  bool weak_fit_since_keyframe_ = false;
+  std::size_t weak_steps_ = 0;  ///< weak-fit scans so far
+};
+
 class LoopClosure2D {
  public:
   /// Throws Error for an unknown registration method or options out of range.
@@ -222,6 +280,10 @@ class LoopClosure2D {
   /// so the keyframe step that holds it takes the rotation test however little it turned.
   /// Returns true when the scan became a keyframe.
   bool add_scan(const Scan2D& scan, const Pose2& odometry_pose, bool weak_fit = false);
+  /// add_scan with the scan's step made elsewhere: by a LoopKeyframes2D of the same options fed
+  /// every scan in order (the same results). Use one way or the other for a whole run. Throws
+  /// Error when the first step is not a keyframe.
+  bool add_step(const Scan2D& scan, const KeyframeStep2D& step);
   /// Optimizes once more (so the outlier flags are current); call after the last scan.
   void finish();
 
@@ -246,9 +308,6 @@ class LoopClosure2D {
     /// pairing_error_2d onto the previous keyframe at the odometry's step (negative: none).
     double pairing_error = -1.0;
   };
-  /// A scan since the last keyframe was registered with a weak fit (add_scan's weak_fit).
-  bool weak_fit_since_keyframe_ = false;
-  std::size_t weak_steps_ = 0;  ///< weak-fit scans so far
   /// How much wider the search between keyframe `newer` and an older one is
   /// (widening_per_weak_step).
   double doubt_widening(std::size_t older, std::size_t newer) const;
@@ -267,20 +326,6 @@ class LoopClosure2D {
                                       double allowed) const;
   /// The estimate gate (m) between keyframe `newer` and an older one (max_correction).
   double correction_allowed(std::size_t older, std::size_t newer) const;
-  struct OdometryInformation {
-    Eigen::Matrix3d information;
-    bool open = false;           ///< the scans leave the step open (open_step_spread)
-    bool rotation_open = false;  ///< the scans leave its rotation open (rotation_open_ratio)
-  };
-  /// The information of an odometry edge from `previous` to `current`, which the odometry put at
-  /// `measurement` (current in previous's frame).
-  OdometryInformation odometry_information(const Scan2D& previous, const Scan2D& current,
-                                           const Pose2& measurement) const;
-  /// Marks a keyframe step rotation-open (rotation_open_ratio, for steps that turn at least
-  /// rotation_open_min_turn or hold a weak fit) and loosens its edge's rotation to
-  /// rotation_open_sigma_theta.
-  void loosen_open_rotation(OdometryInformation& information, const Scan2D& previous,
-                            const Scan2D& current, const Pose2& measurement, bool weak_fit) const;
   void optimize();
   /// Keyframe `keyframe` joined by the keyframes `joined` at their current relative poses,
   /// prepared for verification (kept for the next candidates: a keyframe is often the candidate
@@ -299,6 +344,7 @@ class LoopClosure2D {
 
   LoopClosure2DOptions options_;
   KeyframeGraph<2, Loop2D> graph_;
+  LoopKeyframes2D keyframer_;  ///< add_scan's
   PlaceDatabase2D places_;
   std::vector<Keyframe> keyframes_;
   LoopClosure2DCounts counts_;

@@ -89,16 +89,19 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
+  // Each scan's keyframe step is made here, on the odometry's thread: it needs the odometry
+  // alone, and the loop closure's thread is the slower one where loops are many (intel).
   struct LoopInput {
     Scan2D scan;
-    Pose2 pose = Pose2::Identity();
-    bool weak_fit = false;
+    KeyframeStep2D step;
   };
+  std::optional<LoopKeyframes2D> keyframes;
   std::optional<LoopClosureRun<LoopClosure2D, LoopInput>> closure;
-  if (options.loop_closure)
-    closure.emplace(
-        options.loop, options.loop_closure_thread, kLoopQueueScans,
-        [](LoopClosure2D& loops, LoopInput& in) { loops.add_scan(in.scan, in.pose, in.weak_fit); });
+  if (options.loop_closure) {
+    keyframes.emplace(options.loop);
+    closure.emplace(options.loop, options.loop_closure_thread, kLoopQueueScans,
+                    [](LoopClosure2D& loops, LoopInput& in) { loops.add_step(in.scan, in.step); });
+  }
   const Stopwatch run_time;
   // The registered scans, kept to rebuild the map from the optimized poses and to measure how
   // well revisits agree.
@@ -135,7 +138,9 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       }
     };
     insert(grid, summary.map_error, pose);
-    if (closure) closure->push({mapper.last_scan(), pose, mapper.last_stats().weak_fit});
+    if (closure)
+      closure->push({mapper.last_scan(),
+                     keyframes->add_scan(mapper.last_scan(), pose, mapper.last_stats().weak_fit)});
     Scan2D kept = mapper.last_scan();
     kept.misses = scan.misses;
     kept.times.clear();
