@@ -242,7 +242,7 @@ TEST(Geometry, PointGrid2FindsWhatABruteForceSearchFinds) {
   std::size_t found = 0;
   for (int q = 0; q < 3000; ++q) {
     const Eigen::Vector2d query(far(rng), q % 3 == 0 ? 3.0 + far(rng) * 0.02 : far(rng));
-    for (const double radius : {0.05, 0.3, 1.2, 5.0}) {
+    for (const double radius : {0.05, 0.3, 1.2, 5.0, 40.0}) {
       const std::optional<std::size_t> expected = brute(query, radius * radius);
       std::size_t index = 0;
       double squared = -1.0;
@@ -261,6 +261,9 @@ TEST(Geometry, PointGrid2FindsWhatABruteForceSearchFinds) {
   EXPECT_EQ(index, 10u);
   EXPECT_EQ(squared, 0.0);
   EXPECT_FALSE(grid.nearest(Eigen::Vector2d(1e6, -1e6), 4.0, index, squared));
+  // Far from every point, with a radius reaching them all (beyond the rings it looks at).
+  ASSERT_TRUE(grid.nearest(Eigen::Vector2d(300.0, 300.0), 1e12, index, squared));
+  EXPECT_EQ(index, *brute(Eigen::Vector2d(300.0, 300.0), 1e12));
   EXPECT_FALSE(grid.nearest(Eigen::Vector2d(std::nan(""), 0.0), 4.0, index, squared));
 
   // A stray return kilometres away coarsens the cells, and the answers stay exact.

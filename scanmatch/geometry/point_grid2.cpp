@@ -10,6 +10,9 @@ namespace scanmatch {
 namespace {
 // Cells at most: a scan's stray far return must not make the grid huge (the cells coarsen).
 constexpr double kMaxCells = 4e6;
+// Rings of cells looked at most; a query that needs more (a wide radius with nothing near)
+// looks at every point instead, which costs less than the rings would.
+constexpr long kMaxRings = 32;
 }  // namespace
 
 PointGrid2::PointGrid2(const std::vector<Eigen::Vector2d>& points, double cell) : cell_(cell) {
@@ -81,7 +84,8 @@ bool PointGrid2::nearest(const Eigen::Vector2d& query, double max_squared_distan
   // Ring k holds the cells k away (Chebyshev) from the query's; the points of ring k + 1 and
   // beyond lie at least k cells away, so once the best is nearer than that it is the nearest.
   const long rings = static_cast<long>(std::ceil(radius / cell_)) + 1;
-  for (long k = 0; k <= rings; ++k) {
+  bool settled = false;
+  for (long k = 0; k <= std::min(rings, kMaxRings); ++k) {
     if (k == 0) {
       visit(qx, qy);
     } else {
@@ -95,7 +99,19 @@ bool PointGrid2::nearest(const Eigen::Vector2d& query, double max_squared_distan
       }
     }
     const double reach = static_cast<double>(k) * cell_;
-    if (best < reach * reach || reach > radius) break;
+    if (best < reach * reach || reach > radius) {
+      settled = true;
+      break;
+    }
+  }
+  if (!settled) {
+    for (std::uint32_t i = 0; i < sorted_.size(); ++i) {
+      const double d = (sorted_[i] - query).squaredNorm();
+      if (d < best || (d == best && index_[i] < best_index)) {
+        best = d;
+        best_index = index_[i];
+      }
+    }
   }
   if (!(best <= max_squared_distance)) return false;
   index = best_index;
