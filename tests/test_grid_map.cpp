@@ -497,6 +497,40 @@ TEST(GridMap, RefusesToGrowBeyondTheCellLimit) {
   EXPECT_TRUE(corridor.occupied({2000.0, 0.0}));
 }
 
+TEST(GridMap, NearTheCellLimitItStillGrowsAheadOfTheScans) {
+  // A robot driving 22 m along a corridor, a scan every 10 cm, its map capped at 50 000 cells of 10
+  // cm (a large outdoor log's 100 million at 5 cm, scaled down): growing only to each scan's extent
+  // near the cap copied the whole grid at most scans; grown by what still fits, it is copied a few
+  // times, and holds the same cells.
+  GridMapOptions capped = with_resolution(0.1);
+  capped.max_cells = 50'000;
+  OccupancyGrid grid(capped), unlimited(with_resolution(0.1));
+  int growths = 0;
+  for (int step = 0; step <= 220; ++step) {
+    const Eigen::Isometry2d at = pose(0.1 * step, 0.0, 0.0);
+    const std::vector<Eigen::Vector2d> walls = {{2.0, 1.2}, {2.0, -1.2}, {-1.0, 1.2}, {3.0, 0.0}};
+    const int width = grid.width(), height = grid.height();
+    const Eigen::Vector2d origin = grid.origin();
+    grid.insert_scan(at, walls);
+    unlimited.insert_scan(at, walls);
+    growths += grid.width() != width || grid.height() != height || grid.origin() != origin;
+  }
+  std::printf("growths of the capped grid: %d, %d x %d cells\n", growths, grid.width(),
+              grid.height());
+  EXPECT_LE(static_cast<std::size_t>(grid.width()) * static_cast<std::size_t>(grid.height()),
+            capped.max_cells);
+  EXPECT_LE(growths, 10);
+  for (int step = 0; step <= 60; ++step)
+    for (const Eigen::Vector2d& q :
+         {Eigen::Vector2d(0.5 * step + 2.0, 1.2), Eigen::Vector2d(0.5 * step + 1.0, 0.05),
+          Eigen::Vector2d(0.5 * step, -0.6)})
+      EXPECT_EQ(grid.probability(q), unlimited.probability(q)) << q.transpose();
+  EXPECT_TRUE(grid.occupied({24.0, 1.2}));
+  GridMapOptions none = with_resolution(0.1);
+  none.max_cells = 0;
+  EXPECT_THROW(OccupancyGrid{none}, Error);
+}
+
 TEST(GridMap, RejectsInconsistentOptions) {
   const auto with = [](auto change) {
     GridMapOptions options;

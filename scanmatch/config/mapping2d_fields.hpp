@@ -52,6 +52,7 @@ void describe(Mapper2DConfig& c, Visitor& v) {
 template <typename Visitor>
 void describe(GridMapOptions& g, Visitor& v) {
   v("resolution", g.resolution, "--grid-resolution", "Grid cell size, m");
+  v("max_cells", g.max_cells, nullptr, "most cells a grid may hold (4 bytes each)");
   v("hit_log_odds", g.hit_log_odds, nullptr, "log-odds added where a beam ends");
   v("miss_log_odds", g.miss_log_odds, nullptr, "log-odds added where a beam passes");
   v("min_log_odds", g.min_log_odds, nullptr, "lower clamp of a cell's log-odds");

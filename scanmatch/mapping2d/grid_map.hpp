@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -17,6 +18,8 @@ namespace scanmatch {
 struct GridMapOptions {
   /// Edge length of a square cell, in metres. Default 0.05 (5 cm).
   double resolution = 0.05;
+  /// Most cells the grid may hold (width x height; 4 bytes each): 100 million, 400 MB.
+  std::size_t max_cells = 100'000'000;
   /// Log-odds added to the cell a beam ends in; must be positive. Default 0.85 (one hit alone
   /// gives p = 0.70).
   double hit_log_odds = 0.85;
@@ -57,12 +60,9 @@ inline constexpr std::uint8_t kUnknownPixel = 205;
 
 class OccupancyGrid {
  public:
-  /// Most cells the grid may hold (width x height): 100 million, 400 MB of log-odds.
-  static constexpr std::int64_t kMaxCells = 100'000'000;
-
   /// An empty grid (width and height 0). Throws Error when the options are inconsistent: a
-  /// non-positive resolution, increments or clamps of the wrong sign, or thresholds not
-  /// satisfying 0 < free_threshold < occupied_threshold < 1.
+  /// non-positive resolution or max_cells, increments or clamps of the wrong sign, or thresholds
+  /// not satisfying 0 < free_threshold < occupied_threshold < 1.
   explicit OccupancyGrid(const GridMapOptions& options = {});
 
   /// Ray-traces one scan taken from `sensor_pose` (sensor frame to world frame). For each hit
@@ -74,7 +74,7 @@ class OccupancyGrid {
   /// freed by another beam (a grazing beam would otherwise erase the wall it runs along).
   /// Log-odds are clamped to [min_log_odds, max_log_odds]. Non-finite points are skipped, and
   /// the whole scan when the pose is non-finite. The grid grows to contain every ray; throws
-  /// Error, leaving the grid unchanged, when it would exceed kMaxCells or a point lies too far
+  /// Error, leaving the grid unchanged, when it would exceed max_cells or a point lies too far
   /// from the origin for 32-bit cell indices.
   void insert_scan(const Eigen::Isometry2d& sensor_pose,
                    const std::vector<Eigen::Vector2d>& hits_in_sensor_frame,
