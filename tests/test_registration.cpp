@@ -275,6 +275,11 @@ TEST(Geometry, PointGrid2FindsWhatABruteForceSearchFinds) {
   ASSERT_TRUE(coarse.nearest(Eigen::Vector2d(4e3, -3e3 + 0.5), 1.0, index, squared));
   EXPECT_EQ(index, 2u);
   EXPECT_FALSE(PointGrid2({}, 0.2).nearest(Eigen::Vector2d::Zero(), 1.0, index, squared));
+  // Points whose extent overflows a double still answer exactly.
+  const PointGrid2 huge({{-1.7e308, 0.0}, {1.7e308, 0.0}, {1.0, 1.0}}, 0.2);
+  ASSERT_TRUE(huge.nearest(Eigen::Vector2d(1.1, 1.0), 1.0, index, squared));
+  EXPECT_EQ(index, 2u);
+  EXPECT_FALSE(huge.nearest(Eigen::Vector2d(1e300, 1e300), 1.0, index, squared));
   EXPECT_THROW(PointGrid2(stray, 0.0), Error);
   EXPECT_THROW(PointGrid2(stray, std::nan("")), Error);
 }

@@ -30,6 +30,12 @@ PointGrid2::PointGrid2(const std::vector<Eigen::Vector2d>& points, double cell) 
   }
   if (size_ == 0) return;
   const Eigen::Vector2d extent = high - low;
+  // Points spanning more than a double holds (coordinates near 1e308): one cell, looked at whole.
+  if (!extent.allFinite()) {
+    one_cell_ = true;
+    extent_overflow(points);
+    return;
+  }
   const auto cells = [&](double c) { return (extent.x() / c + 1) * (extent.y() / c + 1); };
   while (cells(cell_) > kMaxCells) cell_ *= 2;
   origin_ = low;
@@ -56,9 +62,31 @@ PointGrid2::PointGrid2(const std::vector<Eigen::Vector2d>& points, double cell) 
   }
 }
 
+void PointGrid2::extent_overflow(const std::vector<Eigen::Vector2d>& points) {
+  width_ = height_ = 1;
+  cell_start_ = {0, static_cast<std::uint32_t>(size_)};
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) continue;
+    sorted_.push_back(points[i]);
+    index_.push_back(static_cast<std::uint32_t>(i));
+  }
+}
+
 bool PointGrid2::nearest(const Eigen::Vector2d& query, double max_squared_distance,
                          std::size_t& index, double& squared_distance) const {
   if (size_ == 0 || !query.allFinite() || !(max_squared_distance >= 0.0)) return false;
+  if (one_cell_) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::uint32_t i = 0; i < sorted_.size(); ++i) {
+      const double d = (sorted_[i] - query).squaredNorm();
+      if (d < best) {
+        best = d;
+        index = index_[i];
+      }
+    }
+    squared_distance = best;
+    return best <= max_squared_distance;
+  }
   const double radius = std::sqrt(max_squared_distance);
   // The query's cell, possibly off the grid; clamped so that a far query cannot overflow.
   const auto cell_index = [&](double v, double low, long cells) {
