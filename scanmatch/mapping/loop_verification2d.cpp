@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/geometry/point_grid2.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 #include "scanmatch/registration/planar/reference2d.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
@@ -23,77 +24,22 @@ bool finite_scan(const Scan2D& scan) {
                      [](const Eigen::Vector2d& p) { return p.allFinite(); });
 }
 
-// Reference points hashed into square cells of the pairing distance: the nearest point within
-// that distance lies in the 3 x 3 cells around a query. Open addressing over the occupied cells,
-// each cell's points stored together: the overlap checks query it for every point at every pose
-// they test, and a node-based map's lookups were most of their time.
-class PointHash {
+// Reference points for the pairing: the distance to the nearest one within the pairing distance.
+// The overlap checks query it for every point at every pose they test.
+class PairingGrid {
  public:
-  PointHash(const std::vector<Eigen::Vector2d>& points, double cell) : cell_(cell) {
-    std::size_t capacity = 16;
-    while (capacity < 2 * points.size()) capacity *= 2;
-    slots_.assign(capacity, Slot{});
-    mask_ = capacity - 1;
-    // Count each cell's points, then place them cell by cell.
-    std::vector<std::size_t> slot_of(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const std::int64_t k = key(cell_of(points[i]));
-      std::size_t at = home(k);
-      while (slots_[at].count > 0 && slots_[at].key != k) at = (at + 1) & mask_;
-      slots_[at].key = k;
-      ++slots_[at].count;
-      slot_of[i] = at;
-    }
-    std::uint32_t begin = 0;
-    for (Slot& slot : slots_) {
-      slot.begin = begin;
-      begin += slot.count;
-    }
-    points_.resize(points.size());
-    std::vector<std::uint32_t> filled(capacity, 0);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const std::size_t at = slot_of[i];
-      points_[slots_[at].begin + filled[at]++] = points[i];
-    }
-  }
+  PairingGrid(const std::vector<Eigen::Vector2d>& points, double cell)
+      : grid_(points, cell), squared_(cell * cell) {}
   /// Distance to the nearest point, or a negative value when none lies within `cell`.
   double nearest(const Eigen::Vector2d& p) const {
-    const Eigen::Vector2i c = cell_of(p);
-    double best = -1.0;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy) {
-        const std::int64_t k = key(c + Eigen::Vector2i(dx, dy));
-        std::size_t at = home(k);
-        while (slots_[at].count > 0 && slots_[at].key != k) at = (at + 1) & mask_;
-        const Slot& slot = slots_[at];
-        for (std::uint32_t i = slot.begin; i < slot.begin + slot.count; ++i) {
-          const double d = (points_[i] - p).norm();
-          if (d <= cell_ && (best < 0.0 || d < best)) best = d;
-        }
-      }
-    return best;
+    std::size_t index = 0;
+    double squared = 0.0;
+    return grid_.nearest(p, squared_, index, squared) ? std::sqrt(squared) : -1.0;
   }
 
  private:
-  struct Slot {
-    std::int64_t key = 0;
-    std::uint32_t begin = 0, count = 0;  // count 0: an empty slot
-  };
-  Eigen::Vector2i cell_of(const Eigen::Vector2d& p) const {
-    return Eigen::Vector2i(static_cast<int>(std::floor(p.x() / cell_)),
-                           static_cast<int>(std::floor(p.y() / cell_)));
-  }
-  static std::int64_t key(const Eigen::Vector2i& c) {
-    return (static_cast<std::int64_t>(c.x()) << 32) ^ static_cast<std::uint32_t>(c.y());
-  }
-  std::size_t home(std::int64_t k) const {
-    return static_cast<std::size_t>((static_cast<std::uint64_t>(k) * 0x9E3779B97F4A7C15ull) >> 17) &
-           mask_;
-  }
-  double cell_;
-  std::vector<Slot> slots_;
-  std::size_t mask_ = 0;
-  std::vector<Eigen::Vector2d> points_;  // grouped by cell, as the slots' begin and count say
+  PointGrid2 grid_;
+  double squared_;
 };
 
 // The farthest return of a scan per bearing bin, in its own frame: what it saw to be free.
@@ -161,7 +107,7 @@ Eigen::Vector2d beam_normal(const Scan2D& scan, std::size_t j) {
 
 // What a scan is checked against: its surfaces filled between samples (as the correlative search
 // scores them: two scans sample a far wall metres apart, and sample-to-sample pairs would miss
-// true loops), hashed for the nearest pair, and the free space it saw. Built once per scan and
+// true loops), gridded for the nearest pair, and the free space it saw. Built once per scan and
 // reused for every pose it is checked at. Joined scans each saw their free space from their own
 // pose: the farthest return from the candidate's pose of a neighbour's point behind a wall says
 // nothing about the space in front of it.
@@ -170,7 +116,7 @@ struct OverlapTarget {
       : OverlapTarget(onto, {{&onto, Pose2::Identity()}}, pair_distance, fill_gap) {}
   OverlapTarget(const Scan2D& onto, const std::vector<PosedScan2D>& views, double pair_distance,
                 double fill_gap)
-      : hash(filled_surfaces(onto, fill_gap, 0.5 * pair_distance), pair_distance) {
+      : surfaces(filled_surfaces(onto, fill_gap, 0.5 * pair_distance), pair_distance) {
     for (const PosedScan2D& v : views) profiles.emplace_back(v.pose.inverse(), v.scan->points);
   }
 
@@ -180,21 +126,21 @@ struct OverlapTarget {
     });
   }
 
-  PointHash hash;                                        // of the filled surfaces
+  PairingGrid surfaces;                                  // the filled surfaces
   std::vector<std::pair<Pose2, RangeProfile>> profiles;  // into each view's frame, what it saw
 };
 
 // `from`'s points moved by `T` against `onto`'s surfaces and free space.
 OverlapCheck check_overlap(const Scan2D& from, const OverlapTarget& onto, const Pose2& T,
                            double free_margin) {
-  const PointHash& hash = onto.hash;
+  const PairingGrid& surfaces = onto.surfaces;
   OverlapCheck c;
   std::size_t paired = 0, free = 0;
   double sum = 0.0;
   Eigen::Matrix2d normals = Eigen::Matrix2d::Zero();
   for (std::size_t j = 0; j < from.points.size(); ++j) {
     const Eigen::Vector2d q = T * from.points[j];
-    const double d = hash.nearest(q);
+    const double d = surfaces.nearest(q);
     if (d >= 0.0) {
       ++paired;
       sum += d;
@@ -227,7 +173,7 @@ struct Pairing {
   std::size_t paired = 0;
   double distance_sum = 0.0;
 };
-Pairing pair_onto(const Scan2D& from, const PointHash& onto, const Pose2& T) {
+Pairing pair_onto(const Scan2D& from, const PairingGrid& onto, const Pose2& T) {
   Pairing out;
   for (const Eigen::Vector2d& p : from.points) {
     const double d = onto.nearest(T * p);
@@ -240,7 +186,7 @@ Pairing pair_onto(const Scan2D& from, const PointHash& onto, const Pose2& T) {
 }
 
 double paired_share(const Scan2D& from, const OverlapTarget& onto, const Pose2& T) {
-  return static_cast<double>(pair_onto(from, onto.hash, T).paired) /
+  return static_cast<double>(pair_onto(from, onto.surfaces, T).paired) /
          static_cast<double>(std::max<std::size_t>(from.points.size(), 1));
 }
 
@@ -252,7 +198,7 @@ double pairing_error_2d(const Scan2D& from, const Scan2D& onto, const Pose2& T,
       !T.matrix().allFinite())
     return -1.0;
   // The surfaces as OverlapTarget fills them; no free space is needed here.
-  const PointHash surfaces(
+  const PairingGrid surfaces(
       filled_surfaces(onto, Registration2DOptions{}.search_fill_gap, 0.5 * pair_distance),
       pair_distance);
   const Pairing p = pair_onto(from, surfaces, T);

@@ -93,7 +93,7 @@ struct PosedScan2D {
 };
 
 /// The current scan of verify_loop_2d with what the checks build of it (its filled surfaces, their
-/// hash, the free space it saw), prepared once for all of its candidates. Holds a copy of the
+/// grid, the free space it saw), prepared once for all of its candidates. Holds a copy of the
 /// scan; `options` must be those of the verifications it is used in.
 class LoopCurrent2D {
  public:
