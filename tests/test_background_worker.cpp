@@ -120,5 +120,25 @@ TEST(BackgroundWorker, DestroyedUnfinishedItDropsTheQueueAndJoins) {
   EXPECT_LT(done.load(), 1000);
 }
 
+TEST(BackgroundWorker, QueuedCountsWhatTheThreadHasNotTakenUp) {
+  GatedWork gate;
+  BackgroundWorker<int> worker(gate.work());
+  for (int i = 0; i < 3; ++i) worker.push(i);
+  // The thread takes the first item up and holds it; the other two wait in the queue.
+  for (int wait = 0; wait < 2000 && worker.queued() != 2; ++wait)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_EQ(worker.queued(), 2u);
+  EXPECT_EQ(gate.done.load(), 0);
+  gate.release = true;
+  worker.finish();
+  EXPECT_EQ(worker.queued(), 0u);
+  EXPECT_EQ(gate.done.load(), 3);
+  int inline_done = 0;
+  BackgroundWorker<int> inline_worker([&](int&) { ++inline_done; }, 0, false);
+  inline_worker.push(1);
+  EXPECT_EQ(inline_worker.queued(), 0u);
+  EXPECT_EQ(inline_done, 1);
+}
+
 }  // namespace
 }  // namespace scanmatch

@@ -85,6 +85,11 @@ class BackgroundWorker {
   /// Time push() and finish() spent waiting for the worker, ms: what the work added to the
   /// caller's time.
   double waited_ms() const { return waited_ms_; }
+  /// Items pushed and not yet taken up by the worker (0 without a thread).
+  std::size_t queued() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return queue_.size();
+  }
 
  private:
   void run() {
@@ -121,7 +126,7 @@ class BackgroundWorker {
   std::function<std::size_t(const Item&)> weight_;
   std::size_t capacity_;
   bool background_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable ready_, space_;
   std::deque<Queued> queue_;
   std::size_t queued_weight_ = 0;

@@ -49,6 +49,8 @@ class LoopClosureRun {
     loop_closure_.finish();
   }
   const LoopClosure& loop_closure() const { return loop_closure_; }
+  /// Inputs pushed and not yet taken up by its thread (0 inline): how far it has fallen behind.
+  std::size_t queued() const { return worker_.queued(); }
   /// After finish(): the counts, the accepted loops and the times per scan or frame of `items`.
   LoopClosureRecord<Counts> record(std::size_t items) const {
     LoopClosureRecord<Counts> r;

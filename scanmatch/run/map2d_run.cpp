@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <future>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -22,6 +23,9 @@ namespace fs = std::filesystem;
 // Scans queued for the loop closure thread before the odometry waits for it (2D scans are small;
 // this absorbs a burst of verifications without holding the odometry back).
 constexpr std::size_t kLoopQueueScans = 256;
+// Scans queued for the loop closure thread from which the odometry's thread makes their keyframe
+// steps itself (the loop closure's thread has fallen behind).
+constexpr std::size_t kStepsHereFromQueued = 2;
 
 Pose to_pose3(const Pose2& T) {
   return from_xyz_rpy(T.translation().x(), T.translation().y(), 0, 0, 0, pose2_angle(T));
@@ -89,18 +93,34 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
 
   Map2DSummary summary;
   summary.has_reference = input.has_reference;
-  // Each scan's keyframe step is made here, on the odometry's thread: it needs the odometry
-  // alone, and the loop closure's thread is the slower one where loops are many (intel).
+  // Each scan's keyframe step (LoopKeyframes2D) needs the odometry alone. It is made on the loop
+  // closure's thread while that keeps up (where the odometry is the slower one: acapulco) and
+  // here, on the odometry's, while it falls behind (intel's many verifications). The steps are
+  // made in order either way, so the results are the same: here only once every step left to
+  // the loop closure's thread is made.
   struct LoopInput {
     Scan2D scan;
-    KeyframeStep2D step;
+    Pose2 pose = Pose2::Identity();
+    bool weak_fit = false;
+    std::optional<KeyframeStep2D> step;  // none: made on the loop closure's thread
   };
-  std::optional<LoopKeyframes2D> keyframes;
+  struct SharedKeyframes {
+    std::mutex mutex;
+    std::optional<LoopKeyframes2D> keyframes;
+    std::size_t left_to_thread = 0;  // queued inputs whose step is not made yet
+  } shared;
   std::optional<LoopClosureRun<LoopClosure2D, LoopInput>> closure;
   if (options.loop_closure) {
-    keyframes.emplace(options.loop);
+    shared.keyframes.emplace(options.loop);
     closure.emplace(options.loop, options.loop_closure_thread, kLoopQueueScans,
-                    [](LoopClosure2D& loops, LoopInput& in) { loops.add_step(in.scan, in.step); });
+                    [&shared](LoopClosure2D& loops, LoopInput& in) {
+                      if (!in.step) {
+                        const std::lock_guard<std::mutex> lock(shared.mutex);
+                        in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit);
+                        --shared.left_to_thread;
+                      }
+                      loops.add_step(in.scan, *in.step);
+                    });
   }
   const Stopwatch run_time;
   // The registered scans, kept to rebuild the map from the optimized poses and to measure how
@@ -138,9 +158,17 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
       }
     };
     insert(grid, summary.map_error, pose);
-    if (closure)
-      closure->push({mapper.last_scan(),
-                     keyframes->add_scan(mapper.last_scan(), pose, mapper.last_stats().weak_fit)});
+    if (closure) {
+      LoopInput in{mapper.last_scan(), pose, mapper.last_stats().weak_fit, std::nullopt};
+      {
+        const std::lock_guard<std::mutex> lock(shared.mutex);
+        if (shared.left_to_thread == 0 && closure->queued() >= kStepsHereFromQueued)
+          in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit);
+        else
+          ++shared.left_to_thread;
+      }
+      closure->push(std::move(in));
+    }
     Scan2D kept = mapper.last_scan();
     kept.misses = scan.misses;
     kept.times.clear();
