@@ -31,17 +31,18 @@ PointGrid2::PointGrid2(const std::vector<Eigen::Vector2d>& points, double cell) 
   if (size_ == 0) return;
   const Eigen::Vector2d extent = high - low;
   // Points spanning more than a double holds (coordinates near 1e308): one cell, looked at whole.
-  if (!extent.allFinite()) {
-    one_cell_ = true;
-    extent_overflow(points);
-    return;
+  one_cell_ = !extent.allFinite();
+  if (!one_cell_) {
+    const auto cells = [&](double c) { return (extent.x() / c + 1) * (extent.y() / c + 1); };
+    while (cells(cell_) > kMaxCells) cell_ *= 2;
+    origin_ = low;
+    width_ = static_cast<long>(extent.x() / cell_) + 1;
+    height_ = static_cast<long>(extent.y() / cell_) + 1;
+  } else {
+    width_ = height_ = 1;
   }
-  const auto cells = [&](double c) { return (extent.x() / c + 1) * (extent.y() / c + 1); };
-  while (cells(cell_) > kMaxCells) cell_ *= 2;
-  origin_ = low;
-  width_ = static_cast<long>(extent.x() / cell_) + 1;
-  height_ = static_cast<long>(extent.y() / cell_) + 1;
-  const auto cell_of = [&](const Eigen::Vector2d& p) {
+  const auto cell_of = [&](const Eigen::Vector2d& p) -> std::size_t {
+    if (one_cell_) return 0;
     const long x = std::min(static_cast<long>((p.x() - low.x()) / cell_), width_ - 1);
     const long y = std::min(static_cast<long>((p.y() - low.y()) / cell_), height_ - 1);
     return static_cast<std::size_t>(y * width_ + x);
@@ -62,46 +63,14 @@ PointGrid2::PointGrid2(const std::vector<Eigen::Vector2d>& points, double cell) 
   }
 }
 
-void PointGrid2::extent_overflow(const std::vector<Eigen::Vector2d>& points) {
-  width_ = height_ = 1;
-  cell_start_ = {0, static_cast<std::uint32_t>(size_)};
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!points[i].allFinite()) continue;
-    sorted_.push_back(points[i]);
-    index_.push_back(static_cast<std::uint32_t>(i));
-  }
-}
-
 bool PointGrid2::nearest(const Eigen::Vector2d& query, double max_squared_distance,
                          std::size_t& index, double& squared_distance) const {
   if (size_ == 0 || !query.allFinite() || !(max_squared_distance >= 0.0)) return false;
-  if (one_cell_) {
-    double best = std::numeric_limits<double>::infinity();
-    for (std::uint32_t i = 0; i < sorted_.size(); ++i) {
-      const double d = (sorted_[i] - query).squaredNorm();
-      if (d < best) {
-        best = d;
-        index = index_[i];
-      }
-    }
-    squared_distance = best;
-    return best <= max_squared_distance;
-  }
-  const double radius = std::sqrt(max_squared_distance);
-  // The query's cell, possibly off the grid; clamped so that a far query cannot overflow.
-  const auto cell_index = [&](double v, double low, long cells) {
-    const double c = std::floor((v - low) / cell_);
-    return static_cast<long>(std::clamp(c, -1.0 - radius / cell_ - 1.0,
-                                        static_cast<double>(cells) + radius / cell_ + 1.0));
-  };
-  const long qx = cell_index(query.x(), origin_.x(), width_);
-  const long qy = cell_index(query.y(), origin_.y(), height_);
   double best = std::numeric_limits<double>::infinity();
   std::uint32_t best_index = 0;
-  const auto visit = [&](long x, long y) {
-    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
-    const auto c = static_cast<std::size_t>(y * width_ + x);
-    for (std::uint32_t i = cell_start_[c]; i < cell_start_[c + 1]; ++i) {
+  // Sorted points [begin, end): the nearer, or of equally near ones the first in the input.
+  const auto look_at = [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) {
       const double d = (sorted_[i] - query).squaredNorm();
       if (d < best || (d == best && index_[i] < best_index)) {
         best = d;
@@ -109,38 +78,46 @@ bool PointGrid2::nearest(const Eigen::Vector2d& query, double max_squared_distan
       }
     }
   };
-  // Ring k holds the cells k away (Chebyshev) from the query's; the points of ring k + 1 and
-  // beyond lie at least k cells away, so once the best is nearer than that it is the nearest.
+  const double radius = std::sqrt(max_squared_distance);
   const long rings = static_cast<long>(std::ceil(radius / cell_)) + 1;
   bool settled = false;
-  for (long k = 0; k <= std::min(rings, kMaxRings); ++k) {
-    if (k == 0) {
-      visit(qx, qy);
-    } else {
-      for (long dx = -k; dx <= k; ++dx) {
-        visit(qx + dx, qy - k);
-        visit(qx + dx, qy + k);
+  if (!one_cell_) {
+    // The query's cell, possibly off the grid; clamped so that a far query cannot overflow.
+    const auto cell_index = [&](double v, double low, long cells) {
+      const double c = std::floor((v - low) / cell_);
+      return static_cast<long>(std::clamp(c, -1.0 - radius / cell_ - 1.0,
+                                          static_cast<double>(cells) + radius / cell_ + 1.0));
+    };
+    const long qx = cell_index(query.x(), origin_.x(), width_);
+    const long qy = cell_index(query.y(), origin_.y(), height_);
+    const auto visit = [&](long x, long y) {
+      if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+      const auto c = static_cast<std::size_t>(y * width_ + x);
+      look_at(cell_start_[c], cell_start_[c + 1]);
+    };
+    // Ring k holds the cells k away (Chebyshev) from the query's; the points of ring k + 1 and
+    // beyond lie at least k cells away, so once the best is nearer than that it is the nearest.
+    for (long k = 0; k <= std::min(rings, kMaxRings); ++k) {
+      if (k == 0) {
+        visit(qx, qy);
+      } else {
+        for (long dx = -k; dx <= k; ++dx) {
+          visit(qx + dx, qy - k);
+          visit(qx + dx, qy + k);
+        }
+        for (long dy = -k + 1; dy <= k - 1; ++dy) {
+          visit(qx - k, qy + dy);
+          visit(qx + k, qy + dy);
+        }
       }
-      for (long dy = -k + 1; dy <= k - 1; ++dy) {
-        visit(qx - k, qy + dy);
-        visit(qx + k, qy + dy);
+      const double reach = static_cast<double>(k) * cell_;
+      if (best < reach * reach || reach > radius) {
+        settled = true;
+        break;
       }
-    }
-    const double reach = static_cast<double>(k) * cell_;
-    if (best < reach * reach || reach > radius) {
-      settled = true;
-      break;
     }
   }
-  if (!settled) {
-    for (std::uint32_t i = 0; i < sorted_.size(); ++i) {
-      const double d = (sorted_[i] - query).squaredNorm();
-      if (d < best || (d == best && index_[i] < best_index)) {
-        best = d;
-        best_index = index_[i];
-      }
-    }
-  }
+  if (!settled) look_at(0, static_cast<std::uint32_t>(sorted_.size()));
   if (!(best <= max_squared_distance)) return false;
   index = best_index;
   squared_distance = best;

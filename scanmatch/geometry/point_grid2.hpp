@@ -32,8 +32,6 @@ class PointGrid2 {
   long width_ = 0, height_ = 0;
   std::size_t size_ = 0;
   bool one_cell_ = false;  ///< the points' extent overflows a double: every query looks at all
-  /// Indexes the finite points as one cell (one_cell_).
-  void extent_overflow(const std::vector<Eigen::Vector2d>& points);
   std::vector<std::uint32_t> cell_start_;  ///< cell c's points: sorted_[cell_start_[c] ..]
   std::vector<Eigen::Vector2d> sorted_;    ///< the finite points, cell by cell, in input order
   std::vector<std::uint32_t> index_;       ///< each sorted point's index in the input

@@ -234,8 +234,8 @@ struct KeyframeStep2D {
 };
 
 /// The odometry's side of LoopClosure2D: keyframes and their odometry edges depend on the
-/// odometry's poses and scans alone, so a run makes them on the odometry's thread (which waits
-/// for loop closure's on intel) and hands them over with the scans (LoopClosure2D::add_step).
+/// odometry's poses and scans alone, so a run can make them on the odometry's thread when loop
+/// closure's falls behind (intel) and hand them over with the scans (LoopClosure2D::add_step).
 class LoopKeyframes2D {
  public:
   /// Throws Error for options out of range (check_loop_closure_2d_options).

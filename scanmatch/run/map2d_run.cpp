@@ -1,5 +1,6 @@
 #include "scanmatch/run/map2d_run.hpp"
 
+#include <atomic>
 #include <filesystem>
 #include <future>
 #include <mutex>
@@ -107,7 +108,9 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
   struct SharedKeyframes {
     std::mutex mutex;
     std::optional<LoopKeyframes2D> keyframes;
-    std::size_t left_to_thread = 0;  // queued inputs whose step is not made yet
+    // Queued inputs whose step is not made yet. Read without the mutex: while it is not 0 the
+    // odometry's thread leaves the steps to the other, and at 0 the other touches no step.
+    std::atomic<std::size_t> left_to_thread{0};
   } shared;
   std::optional<LoopClosureRun<LoopClosure2D, LoopInput>> closure;
   if (options.loop_closure) {
@@ -160,12 +163,11 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     insert(grid, summary.map_error, pose);
     if (closure) {
       LoopInput in{mapper.last_scan(), pose, mapper.last_stats().weak_fit, std::nullopt};
-      {
+      if (shared.left_to_thread.load() == 0 && closure->queued() >= kStepsHereFromQueued) {
         const std::lock_guard<std::mutex> lock(shared.mutex);
-        if (shared.left_to_thread == 0 && closure->queued() >= kStepsHereFromQueued)
-          in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit);
-        else
-          ++shared.left_to_thread;
+        in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit);
+      } else {
+        ++shared.left_to_thread;
       }
       closure->push(std::move(in));
     }

@@ -19,7 +19,7 @@ Registration2DResult run_pl_icp(const Scan2D& current, const Reference2D& prepar
                                 const Registration2DOptions& o, const Pose2& initial) {
   using Vec2 = Eigen::Vector2d;
   const Scan2D& reference = prepared.scan();
-  const PointGrid2& tree = prepared.grid();
+  const PointGrid2& points = prepared.grid();
   const double max_squared = o.max_correspondence_distance * o.max_correspondence_distance;
   const std::vector<FittedLine> no_lines;
   const std::vector<FittedLine>& lines =
@@ -34,7 +34,7 @@ Registration2DResult run_pl_icp(const Scan2D& current, const Reference2D& prepar
       const Vec2 p = r.transform * point;
       std::size_t j = 0;
       double squared = 0.0;
-      if (!tree.nearest(p, max_squared, j, squared)) continue;
+      if (!points.nearest(p, max_squared, j, squared)) continue;
       if (!lines.empty() && !lines[j].normal.isZero()) {
         const FittedLine& line = lines[j];
         pairs.push_back(

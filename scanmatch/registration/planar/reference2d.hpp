@@ -27,8 +27,8 @@ class Reference2D {
   const Scan2D& scan() const { return scan_; }
   /// Of scan().points.
   const KdTree2& tree() const;
-  /// Of scan().points, for nearest points within a radius: the same answers as tree() (of
-  /// equally near points, the first), made in a fraction of its time.
+  /// Of scan().points, for nearest points within a radius: the nearest point as tree() finds it
+  /// (of equally near points, the first), made in a fraction of its time.
   const PointGrid2& grid() const;
   /// fit_scan_lines(scan(), radius, max_gap).
   const std::vector<FittedLine>& lines(double radius, double max_gap) const;

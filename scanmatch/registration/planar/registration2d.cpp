@@ -44,7 +44,7 @@ const std::vector<Registration2DMethod>& registration_2d_methods() {
        run_sparse_icp},
       {"icp", 5, "nothing (brute-force nearest neighbours)", run_icp},
       {"icp-kdtree", 5, "a k-d tree of the reference", run_icp_kdtree},
-      {"pl-icp", 5, "a k-d tree of the reference (and its fitted lines with pl_line_radius)",
+      {"pl-icp", 5, "a grid of the reference's points (and its fitted lines with pl_line_radius)",
        run_pl_icp},
       {"normal-icp", 5, "a k-d tree of the reference; normals of both scans", run_normal_icp},
   };
@@ -112,7 +112,7 @@ class SurfaceDistance {
   double operator()(const Scan2D& current, const Pose2& pose) const {
     if (current.points.empty() || reference_.scan().points.empty()) return cap_;
     const double radius = cap_ + max_gap_;
-    const PointGrid2& tree = reference_.grid();  // once: each call takes the reference's lock
+    const PointGrid2& points = reference_.grid();  // once: each call takes the reference's lock
     double sum = 0.0;
     for (const Eigen::Vector2d& p : current.points) {
       const Eigen::Vector2d q = pose * p;
@@ -121,7 +121,7 @@ class SurfaceDistance {
       double d = cap_;
       // The nearest sample's segments: a point between two samples of a wall is nearest to one
       // of them. Beyond a surface's end the end itself is the nearest.
-      if (tree.nearest(q, radius * radius, k, squared)) {
+      if (points.nearest(q, radius * radius, k, squared)) {
         const auto projected = project_onto_neighbour_segments(reference_.scan(), k, q, max_gap_);
         d = projected ? (projected->point - q).norm() : std::sqrt(squared);
       }
