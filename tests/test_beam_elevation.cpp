@@ -25,13 +25,8 @@ double elevation(const Eigen::Vector3d& p) {
   return std::atan2(p.z(), p.head<2>().norm());
 }
 
-struct Frames {
-  std::vector<PointCloud> clouds;
-  std::vector<double> times;
-};
-
-Frames simulate(const sim::Simulator& simulator, std::size_t frames) {
-  Frames f;
+testing::TimedClouds simulate(const sim::Simulator& simulator, std::size_t frames) {
+  testing::TimedClouds f;
   for (std::size_t i = 0; i < frames; ++i) {
     f.clouds.push_back(simulator.frame(i));
     f.times.push_back(simulator.frame_time(i));
@@ -40,7 +35,7 @@ Frames simulate(const sim::Simulator& simulator, std::size_t frames) {
 }
 
 // The pitch (about the sensor's y axis, deg) of the last estimated pose against the truth's.
-double final_pitch_error_deg(const sim::Simulator& simulator, const Frames& frames,
+double final_pitch_error_deg(const sim::Simulator& simulator, const testing::TimedClouds& frames,
                              const OdometryConfig& config) {
   Odometry odometry(config);
   Pose last = Pose::Identity();
@@ -109,7 +104,7 @@ TEST(BeamElevation, ABiasedCarPitchesAndTheCorrectionTakesItOut) {
   as_delivered.elevation_estimate = false;
   OdometryConfig corrected;
   corrected.elevation_correction_deg = 0.25;
-  const Frames biased_frames = simulate(biased, frames);
+  const testing::TimedClouds biased_frames = simulate(biased, frames);
   const double unbiased = final_pitch_error_deg(exact, simulate(exact, frames), as_delivered);
   const double drifting = final_pitch_error_deg(biased, biased_frames, as_delivered);
   const double taken_out = final_pitch_error_deg(biased, biased_frames, corrected);

@@ -16,6 +16,7 @@
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::TimedClouds;
 
 namespace {
 
@@ -96,14 +97,9 @@ struct Tracked {
   std::size_t recoveries = 0;
 };
 
-struct Frames {
-  std::vector<PointCloud> clouds;
-  std::vector<double> times;
-};
-
 // Every frame of `simulator`, thinned like a keyframe folder when `thin` is given.
-Frames frames_of(const sim::Simulator& simulator, const sim::KeyframeOptions* thin = nullptr) {
-  Frames f;
+TimedClouds frames_of(const sim::Simulator& simulator, const sim::KeyframeOptions* thin = nullptr) {
+  TimedClouds f;
   for (std::size_t i = 0; i < simulator.size(); ++i) {
     f.clouds.push_back(thin ? sim::thin_keyframe(simulator.frame(i), *thin, i)
                             : simulator.frame(i));
@@ -112,7 +108,8 @@ Frames frames_of(const sim::Simulator& simulator, const sim::KeyframeOptions* th
   return f;
 }
 
-Tracked track(const Frames& frames, const std::vector<Pose>& truth, const OdometryConfig& config) {
+Tracked track(const TimedClouds& frames, const std::vector<Pose>& truth,
+              const OdometryConfig& config) {
   Odometry odometry(config);
   Tracked t;
   std::vector<Pose> poses;
@@ -143,7 +140,7 @@ TEST(RecordedAvia, KeyframesAreTrackedBelowTwoPercentWithDefaults) {
   // LiDAR-inertial poses are the reference. Measured 0.24 % (5.28 % before the turned starts;
   // KISS-ICP 9.18 %).
   auto source = open_sequence_folder(folder + "/frames");
-  Frames frames;
+  TimedClouds frames;
   Frame frame;
   while (source->next(frame)) {
     frames.clouds.push_back(frame.cloud);
@@ -173,7 +170,7 @@ TEST(RecordedAvia, ItsMotionReplayedInTheSimulatorFailsAlikeAndIsTrackedAfterThe
   sim::KeyframeOptions thin;
   thin.max_points = 5000;
   thin.point_time = false;
-  const Frames frames = frames_of(simulator, &thin);
+  const TimedClouds frames = frames_of(simulator, &thin);
   const std::vector<Pose>& truth = simulator.ground_truth().poses;
   const Tracked fixed = track(frames, truth, OdometryConfig{});
   const Tracked before = track(frames, truth, without_turned_starts());

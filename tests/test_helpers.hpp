@@ -10,11 +10,13 @@
 #include <functional>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include "scanmatch/core/error.hpp"
+#include "scanmatch/core/point_cloud.hpp"
 
 #include <cstdio>
 
@@ -23,6 +25,22 @@ namespace scanmatch::testing {
 /// Under the sanitizers (scripts/test --sanitize) tests run on fewer frames.
 inline bool sanitized() {
   return std::getenv("SCANMATCH_SANITIZED") != nullptr;
+}
+
+/// Clouds and their times (s), as a simulated sequence gives them.
+struct TimedClouds {
+  std::vector<PointCloud> clouds;
+  std::vector<double> times;
+};
+
+/// Expects the same points and per-point fields, naming the first differing point.
+inline void expect_same_cloud(const PointCloud& actual, const PointCloud& expected) {
+  ASSERT_EQ(actual.size(), expected.size());
+  for (std::size_t i = 0; i < actual.size(); ++i)
+    EXPECT_EQ(actual.points[i], expected.points[i]) << "point " << i;
+  EXPECT_EQ(actual.intensity, expected.intensity);
+  EXPECT_EQ(actual.ring, expected.ring);
+  EXPECT_EQ(actual.time, expected.time);
 }
 
 /// A fresh folder under the system temp dir, removed when the object goes away.

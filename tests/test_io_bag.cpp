@@ -148,14 +148,6 @@ Case make_case(bool cdr) {
   return c;
 }
 
-void expect_same(const PointCloud& a, const PointCloud& e) {
-  ASSERT_EQ(a.size(), e.size());
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.points[i], e.points[i]) << i;
-  EXPECT_EQ(a.intensity, e.intensity);
-  EXPECT_EQ(a.ring, e.ring);
-  EXPECT_EQ(a.time, e.time);
-}
-
 /// Reads every cloud and scan topic of `bag` and compares with the case.
 void expect_case(BagReader& bag, const Case& c, const std::string& encoding) {
   ASSERT_EQ(bag.topics().size(), c.topics.size());
@@ -176,7 +168,7 @@ void expect_case(BagReader& bag, const Case& c, const std::string& encoding) {
     while (bag.next(m)) {
       ASSERT_LT(i, clouds.size());
       std::int64_t stamp = 0;
-      expect_same(decode_cloud_message(m, bag.path(), &stamp), clouds[i]);
+      testing::expect_same_cloud(decode_cloud_message(m, bag.path(), &stamp), clouds[i]);
       EXPECT_EQ(stamp, c.stamps.at(topic)[i]);
       ++i;
     }

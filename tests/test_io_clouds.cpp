@@ -14,6 +14,7 @@
 
 using namespace scanmatch;
 using scanmatch::testing::error_of;
+using scanmatch::testing::expect_same_cloud;
 using scanmatch::testing::TempDir;
 using scanmatch::testing::write_text;
 using Encoding = CloudWriteOptions::Encoding;
@@ -31,14 +32,6 @@ PointCloud sample_cloud(std::size_t n, bool fields = true) {
     }
   }
   return c;
-}
-
-void expect_same(const PointCloud& a, const PointCloud& b) {
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.points, b.points);
-  EXPECT_EQ(a.intensity, b.intensity);
-  EXPECT_EQ(a.ring, b.ring);
-  EXPECT_EQ(a.time, b.time);
 }
 
 std::string gzip(const std::string& data) {
@@ -61,15 +54,15 @@ TEST(CloudIo, RoundTripEveryFormatAndEncoding) {
   const PointCloud cloud = sample_cloud(1000);
   for (auto enc : {Encoding::kAscii, Encoding::kBinary, Encoding::kBinaryCompressed}) {
     write_cloud(dir.file("a.pcd"), cloud, {enc});
-    expect_same(read_cloud(dir.file("a.pcd")), cloud);
+    expect_same_cloud(read_cloud(dir.file("a.pcd")), cloud);
   }
   for (auto enc : {Encoding::kAscii, Encoding::kBinary}) {
     write_cloud(dir.file("a.ply"), cloud, {enc});
-    expect_same(read_cloud(dir.file("a.ply")), cloud);
+    expect_same_cloud(read_cloud(dir.file("a.ply")), cloud);
   }
   for (const char* name : {"a.csv", "a.xyz", "a.txt"}) {
     write_cloud(dir.file(name), cloud);
-    expect_same(read_cloud(dir.file(name)), cloud);
+    expect_same_cloud(read_cloud(dir.file(name)), cloud);
   }
   // KITTI .bin keeps x y z intensity only.
   write_cloud(dir.file("a.bin"), cloud);
@@ -85,7 +78,7 @@ TEST(CloudIo, RoundTripWithoutOptionalFieldsAndEmptyCloud) {
   for (auto enc : {Encoding::kAscii, Encoding::kBinary, Encoding::kBinaryCompressed}) {
     write_cloud(dir.file("b.pcd"), xyz, {enc});
     const PointCloud back = read_cloud(dir.file("b.pcd"));
-    expect_same(back, xyz);
+    expect_same_cloud(back, xyz);
     EXPECT_FALSE(back.has_intensity());
   }
   write_cloud(dir.file("empty.pcd"), PointCloud{});
@@ -100,7 +93,7 @@ TEST(CloudIo, GzipInputIsTransparent) {
   const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   write_text(dir.file("c.pcd.gz"), gzip(raw));
   CloudFileInfo info;
-  expect_same(read_cloud(dir.file("c.pcd.gz"), {}, &info), cloud);
+  expect_same_cloud(read_cloud(dir.file("c.pcd.gz"), {}, &info), cloud);
   EXPECT_TRUE(info.compressed_gzip);
   // A truncated gzip stream is an error, not a short cloud.
   const std::string gz = gzip(raw);

@@ -23,7 +23,7 @@ bool finite_cloud(const PointCloud& cloud) {
                      [](const Point& p) { return p.allFinite(); });
 }
 
-struct OverlapCheck {
+struct CloudOverlapCheck {
   double overlap = 0.0, error = 0.0;
   Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();  ///< sum of n n^T over the paired points
 };
@@ -32,10 +32,11 @@ struct OverlapCheck {
 // nearest neighbour within `pair_distance` and counts when it lies within `plane_distance` of
 // that neighbour's tangent plane: downsampled clouds sample a surface at different spots, so the
 // plane distance, not the point distance, shows whether they agree.
-OverlapCheck check_overlap(const PointCloud& from, const PointCloud& onto, const KdTree& onto_tree,
-                           const std::vector<Eigen::Vector3d>& onto_normals, const Pose& T,
-                           double pair_distance, double plane_distance) {
-  OverlapCheck c;
+CloudOverlapCheck check_cloud_overlap(const PointCloud& from, const PointCloud& onto,
+                                      const KdTree& onto_tree,
+                                      const std::vector<Eigen::Vector3d>& onto_normals,
+                                      const Pose& T, double pair_distance, double plane_distance) {
+  CloudOverlapCheck c;
   const auto max_squared = static_cast<float>(pair_distance * pair_distance);
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
@@ -149,10 +150,10 @@ LoopVerification3D verify_loop_3d(PreparedCloud& prepared_current,
   out.transform = result.transform;
   if (result.information.allFinite()) out.hessian = to_graph_order(result.information);
 
-  const OverlapCheck forward = check_overlap(
+  const CloudOverlapCheck forward = check_cloud_overlap(
       current, candidate, prepared_candidate.tree(), prepared_candidate.normals(kNormalNeighbours),
       out.transform, options.pair_distance, options.plane_distance);
-  OverlapCheck backward = check_overlap(
+  CloudOverlapCheck backward = check_cloud_overlap(
       candidate, current, prepared_current.tree(), prepared_current.normals(kNormalNeighbours),
       out.transform.inverse(), options.pair_distance, options.plane_distance);
   // Both in the candidate's frame, so that the two ways' normals add up.
