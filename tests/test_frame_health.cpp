@@ -20,10 +20,7 @@ using scanmatch::testing::TimedClouds;
 
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
+using scanmatch::testing::median;
 
 }  // namespace
 

@@ -22,7 +22,7 @@
 namespace scanmatch {
 namespace {
 
-struct Pair {
+struct CloudPair {
   PointCloud source, target;
   Pose truth;  ///< T_target_source
 };
@@ -36,10 +36,10 @@ PointCloud transformed(const PointCloud& cloud, const Pose& T) {
 // The source seen from a frame `yaw_deg` and 10 m away from its own: the truth becomes
 // truth * P^-1, and the source's sensor sits at P's translation.
 struct Perturbed {
-  Pair pair;
+  CloudPair pair;
   Eigen::Vector3d source_viewpoint;
 };
-Perturbed perturb(const Pair& pair, double yaw_deg, double direction_deg) {
+Perturbed perturb(const CloudPair& pair, double yaw_deg, double direction_deg) {
   const double d = direction_deg * M_PI / 180;
   const Pose P = from_xyz_rpy(10 * std::cos(d), 10 * std::sin(d), 0, 0, 0, yaw_deg * M_PI / 180);
   return {{transformed(pair.source, P), pair.target, pair.truth * P.inverse()}, P.translation()};
@@ -132,7 +132,7 @@ TEST(Fpfh, DescriptorsDoNotChangeWithARigidMotionOfCloudAndViewpoint) {
 }
 
 // campus-os1 frames 45 onto 40: 0.5 s (3 m) apart, so the two clouds sample the scene differently.
-Pair campus_pair() {
+CloudPair campus_pair() {
   sim::SimOptions so;
   so.preset = "campus-os1";
   so.frames = 46;
@@ -142,7 +142,7 @@ Pair campus_pair() {
 }
 
 TEST(GlobalRegistration, SimulatedCarFramesFromRandomYawsAndTenMetres) {
-  const Pair pair = campus_pair();
+  const CloudPair pair = campus_pair();
   std::mt19937 rng(43);
   std::uniform_real_distribution<double> yaw(-180.0, 180.0), direction(-180.0, 180.0);
   const int trials = scanmatch::testing::sanitized() ? 1 : 3;
@@ -159,7 +159,7 @@ TEST(GlobalRegistration, RealPairsFromFourYawsAndTenMetres) {
   std::ifstream reference(hdl + "/T_target_source.txt");
   const std::optional<Pose> car_truth = car_reference(car);
   ASSERT_TRUE(car_truth) << "no car_cloud401.csv row in carCloudList.csv";
-  const std::vector<std::pair<std::string, Pair>> pairs = {
+  const std::vector<std::pair<std::string, CloudPair>> pairs = {
       {"hdl32_pair",
        {read_cloud(hdl + "/source.ply"), read_cloud(hdl + "/target.ply"), read_matrix(reference)}},
       {"car_pair",
@@ -220,7 +220,7 @@ TEST(GlobalRegistration, FailsAndSaysSoOnAPlaneOrOnNoise) {
 // the target's viewpoint, the origin, halfway between them): two motions fit equally well, so
 // the answer must be "ambiguous", not one of them.
 TEST(GlobalRegistration, RefusesWhenTwoPlacesFitEqually) {
-  const Pair pair = campus_pair();
+  const CloudPair pair = campus_pair();
   const PointCloud &source = pair.source, &place = pair.target;
   PointCloud target;
   std::mt19937 rng(5);

@@ -3,12 +3,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -41,6 +44,24 @@ inline void expect_same_cloud(const PointCloud& actual, const PointCloud& expect
   EXPECT_EQ(actual.intensity, expected.intensity);
   EXPECT_EQ(actual.ring, expected.ring);
   EXPECT_EQ(actual.time, expected.time);
+}
+
+/// How often `what` occurs in `text` (overlapping occurrences count).
+inline std::size_t count_occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+inline double degrees(double rad) {
+  return rad * 180.0 / M_PI;
+}
+
+/// The upper median (the middle element, or the upper of the two middle ones); NaN when empty.
+inline double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
 }
 
 /// A fresh folder under the system temp dir, removed when the object goes away.

@@ -36,10 +36,7 @@ double heading(const Pose& pose) {
   return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
 }
 
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+using scanmatch::testing::median;
 
 }  // namespace
 

@@ -22,9 +22,7 @@
 using namespace scanmatch;
 
 namespace {
-double degrees(double rad) {
-  return rad * 180.0 / M_PI;
-}
+using scanmatch::testing::degrees;
 
 struct Pair {
   PointCloud source, target;

@@ -24,11 +24,7 @@ std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
-std::size_t count(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using scanmatch::testing::count_occurrences;
 }  // namespace
 
 TEST(Report, SvgPlotMapsDataIntoTheFrame) {
@@ -37,7 +33,7 @@ TEST(Report, SvgPlotMapsDataIntoTheFrame) {
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_NE(svg.find("a&lt;b"), std::string::npos);  // escaped legend
   EXPECT_NE(svg.find("stroke=\"#123456\""), std::string::npos);
-  EXPECT_EQ(count(svg, "<path"), 1u);
+  EXPECT_EQ(count_occurrences(svg, "<path"), 1u);
   // Empty input still gives a valid, empty frame.
   EXPECT_NE(svg_plot({}, {}).find("</svg>"), std::string::npos);
 }
@@ -63,12 +59,12 @@ TEST(Report, OdometryRunsBecomeOneSelfContainedPage) {
   // Top view, error over distance, stage times of both runs, the map from above and the side;
   // per run the step error (translation, rotation) and the health record (ctf-icp adds its
   // coarse/fine disagreement; ndt has no such stages).
-  EXPECT_EQ(count(html, "<svg"), 6u + 4u + 3u);
+  EXPECT_EQ(count_occurrences(html, "<svg"), 6u + 4u + 3u);
   EXPECT_NE(html.find("ground truth"), std::string::npos);
   EXPECT_EQ(html.find("http://www.w3.org/2000/svg") != std::string::npos, true);
   // Nothing to fetch: the 3D view's scripts (report_view3d.hpp) are inline.
-  EXPECT_EQ(count(html, "<script src"), 0u);
-  EXPECT_EQ(count(html, "src=\"http"), 0u);
+  EXPECT_EQ(count_occurrences(html, "<script src"), 0u);
+  EXPECT_EQ(count_occurrences(html, "src=\"http"), 0u);
   // A folder that is not a run is refused by name.
   const auto bad = run_cli("report " + dir.path().string() + " --out " + dir.file("x.html"));
   EXPECT_NE(bad.status, 0);
@@ -87,7 +83,7 @@ TEST(Report, OdometryRunsBecomeOneSelfContainedPage) {
       " 2>/dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0);
   const std::string rendered = read_text(dom);
-  EXPECT_EQ(count(rendered, "<svg"), 6u + 4u + 3u);
+  EXPECT_EQ(count_occurrences(rendered, "<svg"), 6u + 4u + 3u);
   EXPECT_NE(rendered.find("Position error over distance"), std::string::npos);
 }
 
@@ -121,9 +117,9 @@ TEST(Report, EachRunShowsItsStepErrorAndHealthOverFrames) {
 
   // With a reference: translation and rotation error of every step, the health record, and the
   // worst steps named with what the record said there.
-  EXPECT_EQ(count(with_part, "Step error against the reference: translation"), 1u);
-  EXPECT_EQ(count(with_part, "Step error against the reference: rotation"), 1u);
-  EXPECT_EQ(count(with_part, "Health: map pairing and flagged frames"), 1u);
+  EXPECT_EQ(count_occurrences(with_part, "Step error against the reference: translation"), 1u);
+  EXPECT_EQ(count_occurrences(with_part, "Step error against the reference: rotation"), 1u);
+  EXPECT_EQ(count_occurrences(with_part, "Health: map pairing and flagged frames"), 1u);
   EXPECT_NE(with_part.find("worst steps"), std::string::npos);
   EXPECT_EQ(with_part.find("No step-error plot"), std::string::npos);
   // The thresholds summary.json counts with, drawn and stated.
@@ -134,9 +130,9 @@ TEST(Report, EachRunShowsItsStepErrorAndHealthOverFrames) {
 
   // Without: the health plot only, and why there is no error plot.
   EXPECT_EQ(without_part.find("Step error against the reference"), std::string::npos);
-  EXPECT_EQ(count(without_part, "Health: map pairing and flagged frames"), 1u);
+  EXPECT_EQ(count_occurrences(without_part, "Health: map pairing and flagged frames"), 1u);
   EXPECT_NE(without_part.find("No step-error plot: this run has no reference"), std::string::npos);
-  EXPECT_EQ(count(html, "<script src"), 0u);
+  EXPECT_EQ(count_occurrences(html, "<script src"), 0u);
 }
 
 TEST(Bench, OneRunGivesEveryTableForEveryMethod) {

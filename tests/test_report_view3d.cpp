@@ -23,11 +23,7 @@ using scanmatch::testing::TempDir;
 
 namespace {
 
-std::size_t count(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using scanmatch::testing::count_occurrences;
 
 const std::string kChromium = "/usr/bin/chromium";
 
@@ -260,8 +256,8 @@ TEST(ReportView3D, PageDrawsMapTrajectoriesAndLoopsInChromium) {
   ASSERT_EQ(r.status, 0) << r.output;
   const std::string html = read_text(page);
   // One file: three.js inline, nothing fetched.
-  EXPECT_GT(count(html, "<script>"), 2u);
-  EXPECT_EQ(count(html, "<script src"), 0u);
+  EXPECT_GT(count_occurrences(html, "<script>"), 2u);
+  EXPECT_EQ(count_occurrences(html, "<script src"), 0u);
   EXPECT_NE(html.find("id=\"view3d-data\""), std::string::npos);
   if (!std::filesystem::exists(kChromium))
     GTEST_SKIP() << "chromium not installed (scripts/bootstrap --browser): 3D view not checked";
@@ -329,15 +325,15 @@ TEST(ReportView3D, WithoutThreeJsThePageKeepsItsTwoDimensionalViews) {
       run_cli("report " + run + " --three-js " + dir.file("no-three") + " --out " + page);
   ASSERT_EQ(r.status, 0) << r.output;
   const std::string html = read_text(page);
-  EXPECT_EQ(count(html, "<script"), 0u);  // nothing that could fail
+  EXPECT_EQ(count_occurrences(html, "<script"), 0u);  // nothing that could fail
   EXPECT_NE(html.find("needs three.js (the Debian package libjs-three"), std::string::npos);
-  const std::size_t svgs = count(html, "<svg");
+  const std::size_t svgs = count_occurrences(html, "<svg");
   EXPECT_GE(svgs, 5u);  // top view, step errors, health, timing, map
   if (!std::filesystem::exists(kChromium))
     GTEST_SKIP() << "chromium not installed (scripts/bootstrap --browser): rendering not checked";
   const std::string dom = run_chromium(dir, page, "--dump-dom");
   EXPECT_EQ(page_status(dom), nlohmann::json({{"three", false}}));
-  EXPECT_EQ(count(dom, "<svg"), svgs);
+  EXPECT_EQ(count_occurrences(dom, "<svg"), svgs);
 }
 
 TEST(ReportView3D, Map2DGridAndLoopsInChromium) {

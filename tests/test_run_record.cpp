@@ -37,7 +37,7 @@ std::vector<std::string> csv_columns(const std::string& path) {
   return record_csv_detail::split_cells(text.substr(0, text.find('\n')));
 }
 
-nlohmann::ordered_json read_json(const std::string& path) {
+nlohmann::ordered_json read_ordered_json(const std::string& path) {
   return nlohmann::ordered_json::parse(read_text(path));
 }
 
@@ -90,8 +90,8 @@ TEST_F(RunRecord, TimingCsvColumnsAreIndexTimestampThenTheDescribedKeys) {
 }
 
 TEST_F(RunRecord, ARunFolderSaysWhatItIsAndIsReadBackByIt) {
-  EXPECT_EQ(read_json(map2d_file("summary.json")).at("kind"), "map2d");
-  EXPECT_EQ(read_json(odometry_file("summary.json")).at("kind"), "odometry");
+  EXPECT_EQ(read_ordered_json(map2d_file("summary.json")).at("kind"), "map2d");
+  EXPECT_EQ(read_ordered_json(odometry_file("summary.json")).at("kind"), "odometry");
 
   const RunFolder map2d = read_run_folder(dir_->file("map2d"));
   EXPECT_EQ(map2d.kind, "map2d");
@@ -155,9 +155,10 @@ TEST_F(RunRecord, SummaryLoopClosureHasTheDescribedCountsThenTheRunsOwn) {
       keys.push_back(key);
     return keys;
   };
-  const nlohmann::ordered_json map2d = read_json(map2d_file("summary.json")).at("loop_closure");
+  const nlohmann::ordered_json map2d =
+      read_ordered_json(map2d_file("summary.json")).at("loop_closure");
   const nlohmann::ordered_json odometry =
-      read_json(odometry_file("summary.json")).at("loop_closure");
+      read_ordered_json(odometry_file("summary.json")).at("loop_closure");
   EXPECT_EQ(keys_of(map2d), expected(described_keys<LoopClosure2DCounts>(), "scan"));
   EXPECT_EQ(keys_of(odometry), expected(described_keys<LoopClosure3DCounts>(), "frame"));
   // The values are the run's.
@@ -173,15 +174,15 @@ TEST_F(RunRecord, SummaryLoopClosureHasTheDescribedCountsThenTheRunsOwn) {
 TEST_F(RunRecord, SummaryOptionsAreTheConfiguration) {
   // Both runs' summary.json "options" come from the configuration's one description, as
   // config.json (odometry's config.json adds the run's keys: map export, loop closure).
-  const nlohmann::ordered_json config = read_json(map2d_file("config.json"));
-  const nlohmann::ordered_json summary = read_json(map2d_file("summary.json"));
+  const nlohmann::ordered_json config = read_ordered_json(map2d_file("config.json"));
+  const nlohmann::ordered_json summary = read_ordered_json(map2d_file("summary.json"));
   EXPECT_EQ(summary.at("options"), config);
   EXPECT_TRUE(config.at("loop_closure").get<bool>());
   EXPECT_EQ(summary.at("method"), config.at("mapper").at("registration").at("method"));
   EXPECT_GT(summary.at("rotation_period_s").get<double>(), 0.0);  // sim: room-2d's laser turns
   EXPECT_FALSE(summary.at("deskewed").get<bool>());               // deskew is off by default
-  nlohmann::ordered_json odometry = read_json(odometry_file("config.json"));
+  nlohmann::ordered_json odometry = read_ordered_json(odometry_file("config.json"));
   for (const char* run_key : {"loop_closure", "loop_closure_thread", "map_export", "loop"})
     EXPECT_EQ(odometry.erase(run_key), 1u) << run_key;
-  EXPECT_EQ(read_json(odometry_file("summary.json")).at("options"), odometry);
+  EXPECT_EQ(read_ordered_json(odometry_file("summary.json")).at("options"), odometry);
 }

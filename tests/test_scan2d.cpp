@@ -32,9 +32,7 @@ using Vec2 = Eigen::Vector2d;
 
 namespace {
 
-double degrees(double rad) {
-  return rad * 180 / M_PI;
-}
+using scanmatch::testing::degrees;
 
 using scanmatch::testing::nearest_wall;
 using scanmatch::testing::Segment;

@@ -19,10 +19,7 @@ using namespace scanmatch::sim;
 namespace {
 constexpr double kDeg = M_PI / 180.0;
 
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+using scanmatch::testing::median;
 
 double yaw_of(const Pose& pose) {
   return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));

@@ -68,7 +68,7 @@ class PyOdometry {
 };
 
 // The docstring of last_stats: each key of the description (frame_stats.hpp) with its help text.
-const char* stats_doc() {
+const char* frame_stats_doc() {
   static const std::string doc = record_doc<FrameStats>(
       "timing and diagnostics of the last frame (dict), None before the first:");
   return doc.c_str();
@@ -123,7 +123,7 @@ bad shapes raise ValueError.)doc")
             if (o.stats().empty()) return py::none();
             return record_dict(o.stats().back());
           },
-          stats_doc())
+          frame_stats_doc())
       .def_property_readonly(
           "stats",
           [](const PyOdometry& o) {

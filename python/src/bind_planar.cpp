@@ -63,7 +63,7 @@ class PyMapper2D {
 };
 
 // The docstring of Mapper2D.last_stats: each key of the description (scan2d_stats.hpp).
-const char* stats_doc() {
+const char* scan_stats_doc() {
   static const std::string doc = record_doc<Scan2DStats>(
       "timing and diagnostics of the last scan (dict), None before the first:");
   return doc.c_str();
@@ -172,7 +172,7 @@ motion prior (last_stats["bridged"]).)doc")
             if (p.stats().empty()) return py::none();
             return record_dict(p.stats().back());
           },
-          stats_doc())
+          scan_stats_doc())
       .def_property_readonly("stats",
                              [](const PyMapper2D& p) {
                                py::list out;

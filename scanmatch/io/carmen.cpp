@@ -14,9 +14,10 @@ using namespace io_detail;
 // A scan of more beams than this is not a laser scan (the largest real ones have a few thousand).
 constexpr std::uint64_t kMaxBeams = 100000;
 
-class Fields {
+class LineFields {
  public:
-  Fields(const std::vector<std::string_view>& tokens, const std::string& source, std::string where)
+  LineFields(const std::vector<std::string_view>& tokens, const std::string& source,
+             std::string where)
       : tokens_(tokens), source_(source), where_(std::move(where)) {}
   double number(std::size_t i) const {
     need(i + 1);
@@ -102,7 +103,7 @@ CarmenLog parse_carmen_log(std::string_view text, const std::string& source,
     if (content.empty() || content.front() == '#') continue;
     split_tokens(content, tokens);
     if (tokens.empty()) continue;  // only separators
-    const Fields f(tokens, source, "line " + std::to_string(cursor.line_number()));
+    const LineFields f(tokens, source, "line " + std::to_string(cursor.line_number()));
     if (tokens[0] == "FLASER" || tokens[0] == "RLASER") {
       const std::size_t n = f.count(1);
       f.exactly(n + 11);

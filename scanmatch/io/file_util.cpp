@@ -16,11 +16,6 @@
 namespace scanmatch {
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 std::string inflate_gzip(const std::string& path, const std::string& compressed) {
   z_stream stream{};
   if (inflateInit2(&stream, 16 + MAX_WBITS) != Z_OK) fail(path, "cannot start gzip decompression");
@@ -83,7 +78,7 @@ std::string read_file_bytes(const std::string& path) {
   const bool gzip_magic = bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0x1f &&
                           static_cast<unsigned char>(bytes[1]) == 0x8b;
   if (gzip_magic) return inflate_gzip(path, bytes);
-  if (ends_with(path, ".gz") && !bytes.empty())
+  if (path.ends_with(".gz") && !bytes.empty())
     fail(path, "name ends in .gz but the data is not gzip");
   return bytes;
 }
@@ -116,7 +111,7 @@ std::string extension_without_gz(const std::string& path) {
   std::string name = std::filesystem::path(path).filename().string();
   std::transform(name.begin(), name.end(), name.begin(),
                  [](unsigned char c) { return std::tolower(c); });
-  if (ends_with(name, ".gz")) name.resize(name.size() - 3);
+  if (name.ends_with(".gz")) name.resize(name.size() - 3);
   const std::size_t dot = name.rfind('.');
   return dot == std::string::npos ? std::string() : name.substr(dot + 1);
 }

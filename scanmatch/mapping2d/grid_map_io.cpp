@@ -38,11 +38,6 @@ std::string yaml_string(const std::string& text) {
   return quoted + "\"";
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 }  // namespace
 
 std::vector<std::uint8_t> OccupancyGrid::render() const {
@@ -67,7 +62,7 @@ std::vector<std::uint8_t> OccupancyGrid::render() const {
 void OccupancyGrid::write_map_server(const std::string& pgm_or_base_path) const {
   std::string base = pgm_or_base_path;
   for (const char* extension : {".pgm", ".yaml"})
-    if (ends_with(base, extension)) base.resize(base.size() - std::string(extension).size());
+    if (base.ends_with(extension)) base.resize(base.size() - std::string(extension).size());
   const std::string pgm_path = base + ".pgm";
   const std::string yaml_path = base + ".yaml";
   if (log_odds_.empty()) fail(pgm_path, "the occupancy grid is empty: no scan was inserted");

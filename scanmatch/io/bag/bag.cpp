@@ -145,7 +145,6 @@ void BagReader::check_topics(const std::vector<std::string>& names) const {
 namespace {
 
 constexpr std::string_view kRos1Magic = "#ROSBAG V";
-constexpr std::string_view kMcapMagic = "\x89MCAP0\r\n";
 constexpr std::string_view kSqliteMagic{"SQLite format 3\0", 16};
 
 std::string bag_in_folder(const std::string& path) {
@@ -169,7 +168,8 @@ std::unique_ptr<BagReader> open_by_magic(bag_detail::ByteSource source) {
   const std::string_view h = head;
   if (h.substr(0, kRos1Magic.size()) == kRos1Magic)
     return bag_detail::open_ros1_bag(std::move(source));
-  if (h.substr(0, kMcapMagic.size()) == kMcapMagic) return bag_detail::open_mcap(std::move(source));
+  if (h.substr(0, bag_detail::kMcapMagic.size()) == bag_detail::kMcapMagic)
+    return bag_detail::open_mcap(std::move(source));
   if (source.size() == 0) fail(source.name(), "file is empty");
   fail(source.name(), "not a ROS 1 bag, ROS 2 .db3 or MCAP file (unknown first bytes)");
 }

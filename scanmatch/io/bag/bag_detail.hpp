@@ -18,6 +18,9 @@
 
 namespace scanmatch::bag_detail {
 
+/// An MCAP file's first (and last) 8 bytes.
+inline constexpr std::string_view kMcapMagic = "\x89MCAP0\r\n";
+
 /// Largest decompressed chunk accepted (a real chunk is a few MiB).
 inline constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{1} << 30;
 

@@ -13,7 +13,6 @@
 namespace scanmatch::bag_detail {
 namespace {
 
-constexpr std::string_view kMagic = "\x89MCAP0\r\n";
 constexpr std::uint8_t kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05,
                        kChunk = 0x06, kDataEnd = 0x0F;
 constexpr std::uint64_t kMessagePrefix = 2 + 4 + 8 + 8;
@@ -24,9 +23,9 @@ class McapBag : public IndexedBag {
   std::string format() const override { return "MCAP"; }
 
   void index() {
-    if (source_.read(0, std::min<std::uint64_t>(source_.size(), 8), "magic") != kMagic)
+    if (source_.read(0, std::min<std::uint64_t>(source_.size(), 8), "magic") != kMcapMagic)
       fail(source_.name(), "not an MCAP file (bad magic)");
-    std::uint64_t offset = kMagic.size();
+    std::uint64_t offset = kMcapMagic.size();
     try {
       bool done = false;
       while (!done) {

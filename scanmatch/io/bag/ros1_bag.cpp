@@ -14,14 +14,14 @@
 namespace scanmatch::bag_detail {
 namespace {
 
-constexpr std::string_view kMagic = "#ROSBAG V2.0\n";
+constexpr std::string_view kRosbagMagic = "#ROSBAG V2.0\n";
 constexpr std::uint8_t kOpMessage = 0x02, kOpBagHeader = 0x03, kOpChunk = 0x05,
                        kOpConnection = 0x07;
 
 /// The "name=value" fields of a record header (or of a connection record's data).
-class Fields {
+class HeaderFields {
  public:
-  explicit Fields(Cursor& c) : cursor_(c) {
+  explicit HeaderFields(Cursor& c) : cursor_(c) {
     while (!c.at_end()) {
       const std::uint64_t at = c.offset();
       const std::string_view field = c.prefixed32("header field");
@@ -69,16 +69,16 @@ class Ros1Bag : public IndexedBag {
 
   void index() {
     const std::string head =
-        source_.read(0, std::min<std::uint64_t>(source_.size(), kMagic.size()), "header");
-    if (head != kMagic) {
+        source_.read(0, std::min<std::uint64_t>(source_.size(), kRosbagMagic.size()), "header");
+    if (head != kRosbagMagic) {
       const std::string version = head.substr(0, head.find('\n'));
       fail(source_.name(), "unsupported bag version '" + version + "' (only #ROSBAG V2.0)");
     }
-    std::uint64_t offset = kMagic.size();
+    std::uint64_t offset = kRosbagMagic.size();
     try {
       while (offset < source_.size()) offset = top_level_record(offset);
       if (!has_header_)
-        fail(source_.name(), "byte " + std::to_string(kMagic.size()), "no bag header record");
+        fail(source_.name(), "byte " + std::to_string(kRosbagMagic.size()), "no bag header record");
       // A closed bag points at its index section; a file ending before it was cut short.
       if (index_pos_ > source_.size())
         fail(source_.name(), "byte " + std::to_string(source_.size()),
@@ -118,7 +118,7 @@ class Ros1Bag : public IndexedBag {
            "truncated record: data of " + std::to_string(data_len) + " bytes, " +
                std::to_string(source_.size() - data_at) + " remain");
     Cursor hc(header, source_.name(), "", offset + 4);
-    const Fields fields(hc);
+    const HeaderFields fields(hc);
     const std::uint8_t op = fields.number<std::uint8_t>("op");
     if (op == kOpBagHeader) {
       index_pos_ = fields.number<std::uint64_t>("index_pos");
@@ -135,7 +135,7 @@ class Ros1Bag : public IndexedBag {
     return data_at + data_len;
   }
 
-  void chunk(const Fields& fields, std::uint64_t offset, std::uint64_t data_at,
+  void chunk(const HeaderFields& fields, std::uint64_t offset, std::uint64_t data_at,
              std::uint32_t data_len) {
     ChunkRef c;
     c.file_offset = offset;
@@ -153,7 +153,7 @@ class Ros1Bag : public IndexedBag {
       const std::uint64_t header_offset = cursor.offset() + 4;
       const std::string_view header = cursor.prefixed32("record header");
       Cursor hc(header, source_.name(), context, header_offset);
-      const Fields inner(hc);
+      const HeaderFields inner(hc);
       const std::uint64_t data_offset = cursor.offset() + 4;
       const std::string_view data = cursor.prefixed32("record data");
       Cursor dc(data, source_.name(), context, data_offset);
@@ -165,10 +165,10 @@ class Ros1Bag : public IndexedBag {
     }
   }
 
-  void connection(const Fields& fields, Cursor& data) {
+  void connection(const HeaderFields& fields, Cursor& data) {
     const std::uint32_t conn = fields.number<std::uint32_t>("conn");
     const std::string topic(fields.get("topic"));
-    const Fields info(data);
+    const HeaderFields info(data);
     if (slot_of_conn_.count(conn)) return;  // connections are repeated after the chunks
     BagTopic t;
     t.name = topic;
@@ -178,7 +178,7 @@ class Ros1Bag : public IndexedBag {
     slots_.push_back(std::move(t));
   }
 
-  void message(const Fields& fields, std::uint64_t data_offset, std::uint64_t size,
+  void message(const HeaderFields& fields, std::uint64_t data_offset, std::uint64_t size,
                std::int32_t chunk) {
     MessageRef m;
     m.topic = fields.number<std::uint32_t>("conn");  // resolved to a slot in index()
