@@ -12,6 +12,7 @@
 #include "scanmatch/run/map2d_run.hpp"
 #include "scanmatch/sim/simulator.hpp"
 #include "scanmatch/sim/worlds.hpp"
+#include "test_helpers.hpp"
 
 using namespace scanmatch;
 using namespace scanmatch::sim;
