@@ -15,17 +15,11 @@
 #include "test_helpers.hpp"
 
 using namespace scanmatch;
+using scanmatch::testing::count_occurrences;
+using scanmatch::testing::read_text;
 using scanmatch::testing::run_cli;
 using scanmatch::testing::shared_data;
 using scanmatch::testing::TempDir;
-
-namespace {
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-using scanmatch::testing::count_occurrences;
-}  // namespace
 
 TEST(Report, SvgPlotMapsDataIntoTheFrame) {
   SvgSeries line = make_series("a<b", "#123456", {{0, 0}, {10, 5}});
