@@ -38,7 +38,8 @@ void BM_Map2DLog(benchmark::State& state, const std::string& log) {
       const Scan2D scan = scan_from_laser(laser, config.min_range);
       const Pose2 pose = mapper.add_scan(scan, laser.timestamp);
       odometry_ms += mapper.last_stats().ms;
-      loops.add_scan(mapper.last_scan(), pose, mapper.last_stats().weak_fit);
+      const Scan2DStats& stats = mapper.last_stats();
+      loops.add_scan(mapper.last_scan(), pose, stats.weak_fit, stats.bridged || stats.unfit);
     }
     loops.finish();
     loop_ms = loops.counts().total_ms;

@@ -72,20 +72,23 @@ verification={...}, graph={...}, ...); loop_closure_2d_options() lists them.)doc
       }))
       .def(
           "add_scan",
-          [](LoopClosure2D& lc, py::handle points, py::handle pose, bool circular, bool weak_fit) {
+          [](LoopClosure2D& lc, py::handle points, py::handle pose, bool circular, bool weak_fit,
+             bool unfit) {
             const Scan2D scan = scan_from_arrays(points, py::none(), circular, "points");
             const Pose2 odometry = pose2_from(pose, "pose");
             py::gil_scoped_release release;
-            return lc.add_scan(scan, odometry, weak_fit);
+            return lc.add_scan(scan, odometry, weak_fit, unfit);
           },
           py::arg("points"), py::arg("pose"), py::arg("circular") = false,
-          py::arg("weak_fit") = false, R"doc(
-add_scan(points, pose, circular=False, weak_fit=False) -> bool
+          py::arg("weak_fit") = false, py::arg("unfit") = false, R"doc(
+add_scan(points, pose, circular=False, weak_fit=False, unfit=False) -> bool
 
 The next scan ((N, 2) x y in beam order, as registered) with its odometry pose (3x3 or
 (x, y, theta)). weak_fit: the odometry registered it poorly (Mapper2D's last_stats["weak_fit"]),
-so its keyframe step is tested for an open rotation however little it turned. Returns True when
-it became a keyframe (and loops were looked for).)doc")
+so its keyframe step is tested for an open rotation however little it turned. unfit: the
+odometry could not register it (last_stats["bridged"] or ["unfit"]), so its keyframe step's edge
+is held loosely (unfit_step_information). Returns True when it became a keyframe (and loops were
+looked for).)doc")
       .def(
           "finish", [](LoopClosure2D& lc) { lc.finish(); },
           "Optimizes once more so that the outlier flags are current; call after the last scan")

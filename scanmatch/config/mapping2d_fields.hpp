@@ -42,6 +42,13 @@ void describe(Mapper2DConfig& c, Visitor& v) {
     "share of points fitting below which a scan is not the next scan's reference (0: off)");
   v("max_unfit_references_skipped", c.max_unfit_references_skipped, nullptr,
     "scans in a row at most kept from being the reference for fitting poorly");
+  v("unfit_max_correction", c.unfit_max_correction, nullptr,
+    "while the motion is steady, a scan fitting below reference_fit_below is bridged by the prior "
+    "when it departs more than this many m from it (0: no bound)");
+  v("unfit_max_correction_angle", c.unfit_max_correction_angle, nullptr,
+    "... and this many rad (0: no bound)");
+  v("unfit_steady_steps", c.unfit_steady_steps, nullptr,
+    "... steady: the last this-many steps each lie within those bounds of the last one");
   v("submap_scans", c.submap_scans, nullptr,
     "references the search scores against: the last and the ones before it (1: scan to scan)");
   v("submap_link_fit", c.submap_link_fit, nullptr,

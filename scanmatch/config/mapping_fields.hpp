@@ -185,6 +185,9 @@ void describe(LoopClosure2DOptions& o, Visitor& v) {
   v("rotation_open_min_turn", o.rotation_open_min_turn, nullptr,
     "... tested where the step turns at least this much (and where the odometry's fit was weak), "
     "rad");
+  v("unfit_step_information", o.unfit_step_information, nullptr,
+    "share of its information a keyframe step keeps where the odometry could not register a "
+    "scan of it (1: all)");
   v("loop_sigma_xy", o.loop_sigma_xy, nullptr, "Loop edge standard deviation, m");
   v("loop_sigma_theta", o.loop_sigma_theta, nullptr, "Loop edge standard deviation, rad");
   v("skip_recent", o.skip_recent, nullptr, "Newest keyframes that are never candidates");

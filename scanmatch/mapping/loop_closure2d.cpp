@@ -50,6 +50,8 @@ void check_loop_closure_2d_options(const LoopClosure2DOptions& options) {
     throw Error(
         "loop closure: rotation_open_ratio and rotation_open_min_turn must not be negative and "
         "rotation_open_sigma_theta must be positive");
+  if (!(options.unfit_step_information > 0.0 && options.unfit_step_information <= 1.0))
+    throw Error("loop closure: unfit_step_information must be in (0, 1]");
   if (!(options.optimize_above >= 0.0))
     throw Error("loop closure: optimize_above must not be negative");
   if (!(options.max_error_per_floor >= 0.0) || !std::isfinite(options.max_error_per_floor))
@@ -77,9 +79,10 @@ LoopKeyframes2D::LoopKeyframes2D(const LoopClosure2DOptions& options) : options_
 }
 
 KeyframeStep2D LoopKeyframes2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose,
-                                         bool weak_fit) {
+                                         bool weak_fit, bool unfit) {
   const Stopwatch stopwatch;
   weak_fit_since_keyframe_ = weak_fit_since_keyframe_ || weak_fit;
+  unfit_since_keyframe_ = unfit_since_keyframe_ || unfit;
   weak_steps_ += weak_fit;
   KeyframeStep2D step;
   // A non-finite odometry pose would poison the graph: hold the last one instead.
@@ -104,6 +107,7 @@ KeyframeStep2D LoopKeyframes2D::add_scan(const Scan2D& scan, const Pose2& odomet
     if (step.keyframe) {
       loosen_open_rotation(*information, keyframe_points_, scan, motion, weak_fit_since_keyframe_);
       step.information = information->information;
+      if (unfit_since_keyframe_) step.information *= options_.unfit_step_information;
       step.open = information->open;
       step.rotation_open = information->rotation_open;
       step.pairing_error = pairing_error_2d(scan, keyframe_points_, step.measurement,
@@ -117,6 +121,7 @@ KeyframeStep2D LoopKeyframes2D::add_scan(const Scan2D& scan, const Pose2& odomet
     keyframe_odometry_ = step.odometry;
     have_keyframe_ = true;
     weak_fit_since_keyframe_ = false;
+    unfit_since_keyframe_ = false;
   }
   last_offset_ = keyframe_odometry_.inverse() * step.odometry;
   step.offset = last_offset_;
@@ -129,8 +134,9 @@ LoopClosure2D::LoopClosure2D(const LoopClosure2DOptions& options)
   options_.search_every = std::max<std::size_t>(options_.search_every, 1);
 }
 
-bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, bool weak_fit) {
-  return add_step(scan, keyframer_.add_scan(scan, odometry_pose, weak_fit));
+bool LoopClosure2D::add_scan(const Scan2D& scan, const Pose2& odometry_pose, bool weak_fit,
+                             bool unfit) {
+  return add_step(scan, keyframer_.add_scan(scan, odometry_pose, weak_fit, unfit));
 }
 
 bool LoopClosure2D::add_step(const Scan2D& scan, const KeyframeStep2D& step) {

@@ -101,6 +101,19 @@ struct Mapper2DConfig {
   /// 0: off.
   double reference_fit_below = 0.2;
   int max_unfit_references_skipped = 3;
+  /// While the robot moves steadily (its last `unfit_steady_steps` steps each within
+  /// unfit_max_correction and unfit_max_correction_angle of the last one), such a scan's step may
+  /// depart from the constant-velocity prior by no more than that either; farther, the scan is
+  /// bridged by the prior (last_stats().steady_prior). What little fits says little about the
+  /// motion, and a registration on it lands where a few returns happen to line up: on
+  /// freiburg-campus, scans 490-497 (fits 0.05-0.18, the laser seeing little but ground and
+  /// scattered trunks) came out 0.9-2.6 m and up to 37 deg from the prior, backwards twice,
+  /// where the robot drove on at its steady 1.1 m a scan. An unsteady prior (weaving on the
+  /// spot, starting off: 1020-1029) is no better than such a registration and bounds nothing.
+  /// 0 (distance or angle): that bound off.
+  double unfit_max_correction = 0.3;
+  double unfit_max_correction_angle = 10.0 * M_PI / 180;
+  int unfit_steady_steps = 5;
   /// With the correlative search on, the searches score each scan against its reference and,
   /// as an equal second part, the `submap_scans` - 1 references before it (scan to submap):
   /// returns that line up with the last scan only where the robot stood still (wall samples at a
@@ -131,6 +144,10 @@ class Mapper2D {
   /// `whole_turn`: the correlative search looked over every rotation, so any turn is plausible;
   /// `window`: the translation window (m) the winning search looked over.
   bool plausible_correction(const Pose2& correction, bool whole_turn, double window) const;
+  /// The last unfit_steady_steps motions each lie near the last one (unfit_max_correction).
+  bool steady_motion() const;
+  /// `correction` (from the prior) exceeds unfit_max_correction or unfit_max_correction_angle.
+  bool departs_from_prior(const Pose2& correction) const;
   /// `registered` moved along the direction the scans leave open (`spread` about it, if they do)
   /// to the fitting translation nearest the motion prior `guess` (open_step_window).
   Pose2 prior_along_open_direction(const Scan2D& current, const Reference2D& reference,
@@ -144,6 +161,8 @@ class Mapper2D {
   std::deque<std::pair<std::vector<Eigen::Vector2d>, Pose2>> older_references_;
   /// The lengths of the last open_step_speed_steps steps, newest last.
   std::deque<double> recent_step_lengths_;
+  /// The last unfit_steady_steps motions, newest last.
+  std::deque<Pose2> recent_motions_;
   double last_timestamp_ = 0.0, motion_interval_ = 0.0;  ///< s; motion_ took motion_interval_
   Pose2 keyframe_pose_ = Pose2::Identity();
   Pose2 pose_ = Pose2::Identity(), motion_ = Pose2::Identity();

@@ -27,8 +27,13 @@ struct Scan2DStats {
   /// Share of the points within 15 cm of the reference's surfaces at the searched pose (before
   /// the fine stage); -1 where no search ran. The step's health beside its error.
   double fit = -1.0;
-  /// The scan fit too poorly to be the next scan's reference (reference_fit_below).
+  /// The scan fit its reference too poorly to be one (reference_fit_below) ...
+  bool unfit = false;
+  /// ... and was kept from being the next scan's reference (max_unfit_references_skipped).
   bool unfit_reference = false;
+  /// The scan was unfit and its registration departed far from a steady motion: bridged by that
+  /// motion (unfit_max_correction).
+  bool steady_prior = false;
 };
 
 template <typename Stats, typename Visitor>
@@ -50,8 +55,12 @@ void describe(Stats& s, Visitor& v) {
     "in doubt");
   v("long_search", s.long_search, "the long search ran (long_search_window)");
   v("long_search_won", s.long_search_won, "the long search's pose won");
+  v("unfit", s.unfit, "the scan fit its reference too poorly to be one (reference_fit_below)");
   v("unfit_reference", s.unfit_reference,
     "the scan fit too poorly to be the next scan's reference (reference_fit_below)");
+  v("steady_prior", s.steady_prior,
+    "the scan was unfit and departed far from a steady motion: bridged by it "
+    "(unfit_max_correction)");
 }
 
 }  // namespace scanmatch

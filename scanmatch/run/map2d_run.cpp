@@ -103,6 +103,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     Scan2D scan;
     Pose2 pose = Pose2::Identity();
     bool weak_fit = false;
+    bool unfit = false;  // not registered: bridged, or fit too poorly (LoopKeyframes2D::add_scan)
     std::optional<KeyframeStep2D> step;  // none: made on the loop closure's thread
   };
   struct SharedKeyframes {
@@ -119,7 +120,8 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
                     [&shared](LoopClosure2D& loops, LoopInput& in) {
                       if (!in.step) {
                         const std::lock_guard<std::mutex> lock(shared.mutex);
-                        in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit);
+                        in.step =
+                            shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit, in.unfit);
                         --shared.left_to_thread;
                       }
                       loops.add_step(in.scan, *in.step);
@@ -162,10 +164,12 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     };
     insert(grid, summary.map_error, pose);
     if (closure) {
-      LoopInput in{mapper.last_scan(), pose, mapper.last_stats().weak_fit, std::nullopt};
+      const Scan2DStats& stats = mapper.last_stats();
+      LoopInput in{mapper.last_scan(), pose, stats.weak_fit, stats.bridged || stats.unfit,
+                   std::nullopt};
       if (shared.left_to_thread.load() == 0 && closure->queued() >= kStepsHereFromQueued) {
         const std::lock_guard<std::mutex> lock(shared.mutex);
-        in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit);
+        in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit, in.unfit);
       } else {
         ++shared.left_to_thread;
       }
