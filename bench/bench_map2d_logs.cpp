@@ -39,7 +39,7 @@ void BM_Map2DLog(benchmark::State& state, const std::string& log) {
       const Pose2 pose = mapper.add_scan(scan, laser.timestamp);
       odometry_ms += mapper.last_stats().ms;
       const Scan2DStats& stats = mapper.last_stats();
-      loops.add_scan(mapper.last_scan(), pose, stats.weak_fit, stats.bridged || stats.unfit);
+      loops.add_scan(mapper.last_scan(), pose, stats.weak_fit, stats.unregistered());
     }
     loops.finish();
     loop_ms = loops.counts().total_ms;

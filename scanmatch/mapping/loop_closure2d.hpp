@@ -77,7 +77,7 @@ struct LoopClosure2DOptions {
   /// edge's information (its standard deviations doubled at 0.25): its motion is the prior's
   /// guess or a registration on little, and a graph that holds it as firmly as a measured step
   /// bends every other step of a loop instead. freiburg-campus has 26 such scans among 2008, the
-  /// other logs and both simulations none: 1.97 -> 0.61 m loop-closed there (the scans bridged by
+  /// other logs and both simulations none: 1.97 -> 0.62 m loop-closed there (the scans bridged by
   /// the steady prior, unfit_max_correction, included); any share from 0.15 to 0.8 gave 0.52-0.68
   /// m. 1: as firm as the rest.
   double unfit_step_information = 0.25;

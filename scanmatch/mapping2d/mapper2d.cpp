@@ -128,10 +128,10 @@ Pose2 Mapper2D::prior_along_open_direction(const Scan2D& current, const Referenc
 }
 
 bool Mapper2D::steady_motion() const {
-  if (!config_.constant_velocity ||
-      recent_motions_.size() < static_cast<std::size_t>(config_.unfit_steady_steps))
-    return false;
-  return std::all_of(recent_motions_.begin(), recent_motions_.end(),
+  const auto steps = static_cast<std::size_t>(config_.unfit_steady_steps);
+  if (!config_.constant_velocity || recent_motions_.size() < steps) return false;
+  return std::all_of(recent_motions_.end() - static_cast<std::ptrdiff_t>(steps),
+                     recent_motions_.end(),
                      [&](const Pose2& m) { return !departs_from_prior(motion_.inverse() * m); });
 }
 
@@ -259,10 +259,15 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
       // speed (open_step_speed_steps).
       Pose2 prior = guess;
       if (open_step && open && !stats_.weak_fit && !stats_.long_search_won &&
-          !recent_step_lengths_.empty() &&
+          config_.open_step_speed_steps > 0 && !recent_motions_.empty() &&
           (spread.nearest.translation() - guess.translation()).norm() >
               config_.open_step_prior_distance) {
-        std::vector<double> lengths(recent_step_lengths_.begin(), recent_step_lengths_.end());
+        const std::size_t n = std::min(recent_motions_.size(),
+                                       static_cast<std::size_t>(config_.open_step_speed_steps));
+        std::vector<double> lengths;
+        for (auto m = recent_motions_.end() - static_cast<std::ptrdiff_t>(n);
+             m != recent_motions_.end(); ++m)
+          lengths.push_back(m->translation().norm());
         const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
         std::nth_element(lengths.begin(), middle, lengths.end());
         // From the last scan's pose, along the heading registered for this one.
@@ -313,13 +318,9 @@ Pose2 Mapper2D::add_scan(const Scan2D& input, double timestamp) {
   // Re-orthonormalise: chaining thousands of products slowly bends R off SO(2).
   pose = pose2(pose.translation().x(), pose.translation().y(), pose2_angle(pose));
   motion_ = pose_.inverse() * pose;
-  if (config_.open_step_speed_steps > 0) {
-    recent_step_lengths_.push_back(motion_.translation().norm());
-    if (recent_step_lengths_.size() > static_cast<std::size_t>(config_.open_step_speed_steps))
-      recent_step_lengths_.pop_front();
-  }
   recent_motions_.push_back(motion_);
-  if (recent_motions_.size() > static_cast<std::size_t>(config_.unfit_steady_steps))
+  if (recent_motions_.size() >
+      static_cast<std::size_t>(std::max(config_.open_step_speed_steps, config_.unfit_steady_steps)))
     recent_motions_.pop_front();
   motion_interval_ = interval;
   pose_ = pose;

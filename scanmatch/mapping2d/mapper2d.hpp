@@ -144,7 +144,7 @@ class Mapper2D {
   /// `whole_turn`: the correlative search looked over every rotation, so any turn is plausible;
   /// `window`: the translation window (m) the winning search looked over.
   bool plausible_correction(const Pose2& correction, bool whole_turn, double window) const;
-  /// The last unfit_steady_steps motions each lie near the last one (unfit_max_correction).
+  /// The last unfit_steady_steps motions each lie near the newest (departs_from_prior).
   bool steady_motion() const;
   /// `correction` (from the prior) exceeds unfit_max_correction or unfit_max_correction_angle.
   bool departs_from_prior(const Pose2& correction) const;
@@ -159,9 +159,8 @@ class Mapper2D {
   /// The references before keyframe_ still in the search (submap_scans), newest first: their
   /// filled surfaces (filled_surfaces, in their own frames) and their poses.
   std::deque<std::pair<std::vector<Eigen::Vector2d>, Pose2>> older_references_;
-  /// The lengths of the last open_step_speed_steps steps, newest last.
-  std::deque<double> recent_step_lengths_;
-  /// The last unfit_steady_steps motions, newest last.
+  /// The last steps' motions, newest last: as many as open_step_speed_steps (their lengths) and
+  /// unfit_steady_steps (steady_motion) need.
   std::deque<Pose2> recent_motions_;
   double last_timestamp_ = 0.0, motion_interval_ = 0.0;  ///< s; motion_ took motion_interval_
   Pose2 keyframe_pose_ = Pose2::Identity();

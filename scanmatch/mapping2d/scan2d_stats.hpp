@@ -34,6 +34,10 @@ struct Scan2DStats {
   /// The scan was unfit and its registration departed far from a steady motion: bridged by that
   /// motion (unfit_max_correction).
   bool steady_prior = false;
+
+  /// The odometry could not register the scan (bridged, or unfit): loop closure holds its step
+  /// loosely (LoopClosure2D::add_scan's `unfit`).
+  bool unregistered() const { return bridged || unfit; }
 };
 
 template <typename Stats, typename Visitor>

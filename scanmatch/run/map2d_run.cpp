@@ -165,8 +165,7 @@ Map2DSummary run_map2d(const Scans2D& input, const std::string& run_folder,
     insert(grid, summary.map_error, pose);
     if (closure) {
       const Scan2DStats& stats = mapper.last_stats();
-      LoopInput in{mapper.last_scan(), pose, stats.weak_fit, stats.bridged || stats.unfit,
-                   std::nullopt};
+      LoopInput in{mapper.last_scan(), pose, stats.weak_fit, stats.unregistered(), std::nullopt};
       if (shared.left_to_thread.load() == 0 && closure->queued() >= kStepsHereFromQueued) {
         const std::lock_guard<std::mutex> lock(shared.mutex);
         in.step = shared.keyframes->add_scan(in.scan, in.pose, in.weak_fit, in.unfit);
