@@ -264,6 +264,31 @@ TEST(Geometry, PointGrid2FindsWhatABruteForceSearchFinds) {
   EXPECT_EQ(index, *brute(Eigen::Vector2d(300.0, 300.0), 1e12));
   EXPECT_FALSE(grid.nearest(Eigen::Vector2d(std::nan(""), 0.0), 4.0, index, squared));
 
+  // Full cells ruled out by their distance: a lattice with points on the cell edges, listed
+  // twice (ties), queried on edges, corners and between them. Still the first of the nearest.
+  std::vector<Eigen::Vector2d> lattice;
+  for (int copy = 0; copy < 2; ++copy)
+    for (int x = 0; x <= 40; ++x)
+      for (int y = 0; y <= 40; ++y) lattice.emplace_back(0.05 * x, 0.05 * y);
+  const PointGrid2 dense(lattice, 0.2);
+  for (int qx = -4; qx <= 84; ++qx)
+    for (int qy = -4; qy <= 84; qy += 7) {
+      const Eigen::Vector2d query(0.025 * qx, 0.025 * qy);
+      for (const double radius : {0.03, 0.3}) {
+        std::optional<std::size_t> expected;
+        for (std::size_t i = 0; i < lattice.size(); ++i) {
+          const double d = (lattice[i] - query).squaredNorm();
+          if (d <= radius * radius && (!expected || d < (lattice[*expected] - query).squaredNorm()))
+            expected = i;
+        }
+        const bool hit = dense.nearest(query, radius * radius, index, squared);
+        ASSERT_EQ(hit, expected.has_value()) << query.transpose() << " within " << radius;
+        if (hit) {
+          EXPECT_EQ(index, *expected) << query.transpose();
+        }
+      }
+    }
+
   // A stray return kilometres away coarsens the cells, and the answers stay exact.
   std::vector<Eigen::Vector2d> stray = {{0.0, 0.0}, {0.3, 0.1}, {4e3, -3e3}};
   const PointGrid2 coarse(stray, 0.2);

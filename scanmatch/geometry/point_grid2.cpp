@@ -90,27 +90,51 @@ bool PointGrid2::nearest(const Eigen::Vector2d& query, double max_squared_distan
     };
     const long qx = cell_index(query.x(), origin_.x(), width_);
     const long qy = cell_index(query.y(), origin_.y(), height_);
-    const auto visit = [&](long x, long y) {
+    // The query within its cell. Where it lies inside it (not clamped), cells and rings can be
+    // ruled out by their distance from it, taken a hair short (`slack`) so that a point rounded
+    // into its cell is never ruled out.
+    const double fx = query.x() - origin_.x() - static_cast<double>(qx) * cell_;
+    const double fy = query.y() - origin_.y() - static_cast<double>(qy) * cell_;
+    const double slack = 1e-9 * (1.0 + std::abs(query.x()) + std::abs(query.y()));
+    const double edge = std::min({fx, cell_ - fx, fy, cell_ - fy}) - slack;
+    const bool inside = edge >= 0.0;
+    // The distance along one axis from the query to the cell `d` cells from its own.
+    const auto gap = [&](long d, double f) {
+      if (d == 0) return 0.0;
+      const double g =
+          d > 0 ? static_cast<double>(d) * cell_ - f : f + static_cast<double>(-d - 1) * cell_;
+      return std::max(0.0, g - slack);
+    };
+    const auto visit = [&](long dx, long dy) {
+      const long x = qx + dx, y = qy + dy;
       if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
       const auto c = static_cast<std::size_t>(y * width_ + x);
-      look_at(cell_start_[c], cell_start_[c + 1]);
+      const std::uint32_t begin = cell_start_[c], end = cell_start_[c + 1];
+      if (begin == end) return;
+      // A full cell is looked at only when it could hold a point as near as the best so far
+      // (for a few points the test costs more than it saves).
+      if (inside && end - begin > 3) {
+        const double gx = gap(dx, fx), gy = gap(dy, fy);
+        if (gx * gx + gy * gy > best) return;
+      }
+      look_at(begin, end);
     };
-    // Ring k holds the cells k away (Chebyshev) from the query's; the points of ring k + 1 and
-    // beyond lie at least k cells away, so once the best is nearer than that it is the nearest.
+    // Ring k holds the cells k away (Chebyshev) from the query's; the points beyond it lie at
+    // least k cells away, and from a query inside its cell `edge` further.
     for (long k = 0; k <= std::min(rings, kMaxRings); ++k) {
       if (k == 0) {
-        visit(qx, qy);
+        visit(0, 0);
       } else {
-        for (long dx = -k; dx <= k; ++dx) {
-          visit(qx + dx, qy - k);
-          visit(qx + dx, qy + k);
+        for (long d = -k; d <= k; ++d) {
+          visit(d, -k);
+          visit(d, k);
         }
-        for (long dy = -k + 1; dy <= k - 1; ++dy) {
-          visit(qx - k, qy + dy);
-          visit(qx + k, qy + dy);
+        for (long d = -k + 1; d <= k - 1; ++d) {
+          visit(-k, d);
+          visit(k, d);
         }
       }
-      const double reach = static_cast<double>(k) * cell_;
+      const double reach = static_cast<double>(k) * cell_ + (inside ? edge : 0.0);
       if (best < reach * reach || reach > radius) {
         settled = true;
         break;
