@@ -1480,3 +1480,38 @@ TEST(Scan2D, AFineStageThatFitsWorseThanTheSearchKeepsTheSearchPose) {
   EXPECT_LT(surface_distance(current, reference, guarded.transform, o.search_fill_gap),
             surface_distance(current, reference, unguarded.transform, o.search_fill_gap));
 }
+
+TEST(Scan2D, IterationsCutShortByACycleEndAsTheLimitWould) {
+  // Each iteration's pose follows from the pose before it alone, so single iterations chained
+  // from one another are the plain iteration, step by step. A run that finds its pose met again
+  // and stops (IterationCycle) must end exactly where that chain ends at the iteration limit.
+  const auto simulated = pairs(40);
+  std::size_t unconverged = 0;
+  for (const std::string& method : registration_2d_method_names()) {
+    for (const int limit : {7, 30, 50}) {
+      Registration2DOptions o;
+      o.method = method;
+      o.search_window = 0.0;                             // the method alone,
+      o.coarse_rotation = o.coarse_translation = false;  // its iterations alone (sparse-icp)
+      o.max_iterations = limit;
+      Registration2DOptions one = o;
+      one.max_iterations = 1;
+      for (const auto& p : simulated) {
+        const Scan2D current = scan_from_laser(p.current), reference = scan_from_laser(p.reference);
+        const Registration2DResult run = register_scans(current, reference, o);
+        Registration2DResult chained;
+        for (int i = 0; i < limit && !chained.converged; ++i)
+          chained = register_scans(current, reference, one, chained.transform);
+        ASSERT_TRUE(run.transform.matrix() == chained.transform.matrix())
+            << method << " limit " << limit << "\n"
+            << run.transform.matrix() << "\n"
+            << chained.transform.matrix();
+        EXPECT_EQ(run.converged, chained.converged) << method;
+        EXPECT_EQ(run.pairs, chained.pairs) << method;
+        EXPECT_EQ(run.error, chained.error) << method;
+        unconverged += !run.converged && limit == 50;
+      }
+    }
+  }
+  EXPECT_GT(unconverged, 0u);  // some runs met the limit (cycling), so the cut was exercised
+}

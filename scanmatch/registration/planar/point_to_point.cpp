@@ -53,6 +53,7 @@ Registration2DResult point_to_point_icp(const Scan2D& current, const Reference2D
   Registration2DResult r;
   r.transform = initial;
   PointPairs pairs;
+  IterationCycle cycle;  // a pose met again: the rest repeats
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
     pairs.clear();
     const Eigen::Matrix2d R = r.transform.linear();
@@ -76,6 +77,7 @@ Registration2DResult point_to_point_icp(const Scan2D& current, const Reference2D
       r.converged = true;
       break;
     }
+    if (cycle.closes(r, o.max_iterations)) break;  // the limit's outcome, known
   }
   r.iterations = std::min(r.iterations, o.max_iterations);
   return r;

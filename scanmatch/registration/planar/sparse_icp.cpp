@@ -60,6 +60,7 @@ Registration2DResult run_sparse_icp(const Scan2D& current, const Reference2D& pr
       point_to_line && o.sparse_line_radius > 0.0
           ? prepared.lines(o.sparse_line_radius, o.max_correspondence_distance)
           : no_lines;
+  planar::IterationCycle cycle;  // a pose met again: the rest repeats
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
     const std::vector<Vec2> moved = planar::transformed(current.points, r.transform);
     const CorrespondencePath path = path_tracer.trace(moved);
@@ -126,6 +127,7 @@ Registration2DResult run_sparse_icp(const Scan2D& current, const Reference2D& pr
       r.converged = true;
       break;
     }
+    if (cycle.closes(r, o.max_iterations)) break;  // the limit's outcome, known
   }
   r.iterations = std::min(r.iterations, o.max_iterations);
   return r;
