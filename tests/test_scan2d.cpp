@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 
 #include "planar_scene.hpp"
@@ -18,6 +19,7 @@
 #include "scanmatch/features/angle_histogram.hpp"
 #include "scanmatch/registration/planar/correlative_search.hpp"
 #include "scanmatch/registration/planar/correspondence_path.hpp"
+#include "scanmatch/registration/planar/line_fitting.hpp"
 #include "scanmatch/registration/planar/point_to_line.hpp"
 #include "scanmatch/registration/planar/point_to_point.hpp"
 #include "scanmatch/registration/planar/registration2d.hpp"
@@ -1452,6 +1454,34 @@ TEST(Scan2D, SurfaceDistanceMeasuresOffsetsFromTheReferenceSurfaces) {
   EXPECT_NEAR(surface_distance(current, wall, Pose2::Identity(), 0.3, 0.5), 0.25, 1e-12);
   // Capped: a point far from everything counts the cap.
   EXPECT_NEAR(surface_distance(current, wall, pose2(0.0, 5.0, 0.0), 1.0, 0.2), 0.2, 1e-12);
+
+  // Against the definition on a simulated pair, from poses near and far: the nearest sample of
+  // all (no search radius), the segments to its beam neighbours, capped; the same sum to the bit.
+  const auto simulated = pairs(6);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> shift(-1.5, 1.5), turn(-0.3, 0.3);
+  for (const auto& p : simulated) {
+    const Scan2D cur = scan_from_laser(p.current), ref = scan_from_laser(p.reference);
+    for (int k = 0; k < 8; ++k) {
+      const Pose2 pose = k == 0 ? p.truth : pose2(shift(rng), shift(rng), turn(rng)) * p.truth;
+      for (const auto& [gap, cap] : {std::pair{1.0, 0.2}, std::pair{0.3, 0.5}}) {
+        double sum = 0.0;
+        for (const Vec2& point : cur.points) {
+          const Vec2 q = pose * point;
+          std::size_t nearest = 0;
+          for (std::size_t j = 1; j < ref.points.size(); ++j)
+            if ((ref.points[j] - q).squaredNorm() < (ref.points[nearest] - q).squaredNorm())
+              nearest = j;
+          const auto projected = project_onto_neighbour_segments(ref, nearest, q, gap);
+          const double d =
+              projected ? (projected->point - q).norm() : (ref.points[nearest] - q).norm();
+          sum += std::min(d, cap);
+        }
+        EXPECT_EQ(surface_distance(cur, ref, pose, gap, cap),
+                  sum / static_cast<double>(cur.points.size()));
+      }
+    }
+  }
 }
 
 TEST(Scan2D, AFineStageThatFitsWorseThanTheSearchKeepsTheSearchPose) {

@@ -111,7 +111,9 @@ class SurfaceDistance {
 
   double operator()(const Scan2D& current, const Pose2& pose) const {
     if (current.points.empty() || reference_.scan().points.empty()) return cap_;
-    const double radius = cap_ + max_gap_;
+    // A segment within `cap` of the point and at most max_gap long has an end within
+    // hypot(cap, max_gap / 2) of it: with no sample that near, the distance is `cap` anyway.
+    const double radius = std::hypot(cap_, 0.5 * max_gap_) + 1e-9;
     const PointGrid2& points = reference_.grid();  // once: each call takes the reference's lock
     double sum = 0.0;
     for (const Eigen::Vector2d& p : current.points) {
