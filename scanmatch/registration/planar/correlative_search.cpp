@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -50,10 +49,7 @@ constexpr int kCodeScale = 255;
 
 struct LikelihoodGrid {
   double resolution = 0.05;
-  Vec2 origin = Vec2::Zero();  ///< world position of the lattice's cell (0, 0) corner
-  /// The lattice cell the grid's cell (0, 0) is: a grid cut from a larger one keeps its lattice
-  /// (cell (x, y) is floor((p - origin) / resolution) - offset, in integers, for the same codes).
-  Eigen::Vector2i offset = Eigen::Vector2i::Zero();
+  Vec2 origin = Vec2::Zero();  ///< world position of cell (0, 0)'s corner
   int width = 0, height = 0;
   std::array<float, kCodeScale + 1> likelihood{};  ///< by code
   /// Level k's codes start at k * cells(): level 0 is the smoothed likelihood; level k's (x, y) is
@@ -73,32 +69,13 @@ struct LikelihoodGrid {
   float at(int k, int x, int y) const { return likelihood[code(k, x, y)]; }
 };
 
-/// Where a grid's cells lie: its lattice's corner and cell size.
-struct Lattice {
-  Vec2 origin = Vec2::Zero();
-  double resolution = 0.05;
-};
-
-/// The lattice of a grid over points spanning low..high: cells of `resolution`, coarser where the
-/// area is huge, so memory stays bounded; its corner one top block and three cells below `low`.
-Lattice lattice_over(const Vec2& low, const Vec2& high, double resolution) {
-  const auto cells = [&](double r) {
-    const Vec2 size = high - low;
-    return (size.x() / r + kTopSide + 6) * (size.y() / r + kTopSide + 6);
-  };
-  while (cells(resolution) > static_cast<double>(kMaxCellsPerLevel)) resolution *= 2;
-  return {low - Vec2::Constant((kTopSide + 3) * resolution), resolution};
-}
-
 /// The grid spans the reference points only: a current point landing elsewhere scores nothing.
 /// Below them it reaches one top block further, so that the levels bound the blocks that start
-/// outside (`g.at` is zero off the grid). With `lattice` its cells are that lattice's (a part of
-/// a grid over more points, cut to these: the same codes where these points reach), else those
-/// of lattice_over these points. With `older` (surfaces of earlier scans, in the reference's
-/// frame) a cell holds the mean of the two sets' likelihoods, each code standing for code / 255.
+/// outside (`g.at` is zero off the grid). Coarser cells where the area is huge, so memory stays
+/// bounded. With `older` (surfaces of earlier scans, in the reference's frame) a cell holds the
+/// mean of the two sets' likelihoods, each code standing for code / 255.
 LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution,
-                         const std::vector<Vec2>& older = {},
-                         const std::optional<Lattice>& lattice = std::nullopt) {
+                         const std::vector<Vec2>& older = {}) {
   LikelihoodGrid g;
   Vec2 low = reference.front(), high = reference.front();
   for (const std::vector<Vec2>* points : {&reference, &older})
@@ -106,19 +83,18 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution,
       low = low.cwiseMin(p);
       high = high.cwiseMax(p);
     }
-  const Lattice cells = lattice ? *lattice : lattice_over(low, high, resolution);
-  resolution = cells.resolution;
-  g.resolution = resolution;
-  g.origin = cells.origin;
-  // The lattice cells from one top block and three cells below the points to three above them.
-  const auto index = [&](double v, double o) {
-    return static_cast<int>(std::floor((v - o) / resolution));
+  const auto cells = [&](double r) {
+    const Vec2 size = high - low;
+    return (size.x() / r + kTopSide + 6) * (size.y() / r + kTopSide + 6);
   };
-  g.offset = Eigen::Vector2i(index(low.x(), g.origin.x()) - (kTopSide + 3),
-                             index(low.y(), g.origin.y()) - (kTopSide + 3))
-                 .cwiseMax(0);
-  g.width = index(high.x(), g.origin.x()) + 4 - g.offset.x();
-  g.height = index(high.y(), g.origin.y()) + 4 - g.offset.y();
+  while (cells(resolution) > static_cast<double>(kMaxCellsPerLevel)) resolution *= 2;
+  low -= Vec2::Constant((kTopSide + 3) * resolution);
+  high += Vec2::Constant(3 * resolution);
+  const Vec2 size = high - low;
+  g.resolution = resolution;
+  g.origin = low;
+  g.width = static_cast<int>(std::ceil(size.x() / resolution)) + 1;
+  g.height = static_cast<int>(std::ceil(size.y() / resolution)) + 1;
   const std::size_t n = g.cells();
   const std::size_t width = static_cast<std::size_t>(g.width);
   g.codes.assign(n * kLevels + 16, 0);
@@ -134,8 +110,8 @@ LikelihoodGrid make_grid(const std::vector<Vec2>& reference, double resolution,
     }
   const auto stamp = [&](const std::vector<Vec2>& points, Code* layer) {
     for (const Vec2& p : points) {
-      const int cx = index(p.x(), g.origin.x()) - g.offset.x();
-      const int cy = index(p.y(), g.origin.y()) - g.offset.y();
+      const int cx = static_cast<int>(std::floor((p.x() - low.x()) / resolution));
+      const int cy = static_cast<int>(std::floor((p.y() - low.y()) / resolution));
       for (int dy = -kRadius; dy <= kRadius; ++dy)
         for (int dx = -kRadius; dx <= kRadius; ++dx) {
           const int x = cx + dx, y = cy + dy;
@@ -299,8 +275,8 @@ void ScanOnGrid::prepare(int angles) {
     auto& out = cells[static_cast<std::size_t>(a + angles)];
     out.reserve(points_.size());
     for (const Vec2& p : points_)
-      out.push_back({cell(c * p.x() - s * p.y() + start.x()) - g.offset.x(),
-                     cell(s * p.x() + c * p.y() + start.y()) - g.offset.y()});
+      out.push_back(
+          {cell(c * p.x() - s * p.y() + start.x()), cell(s * p.x() + c * p.y() + start.y())});
   }
   cells_ = std::move(cells);
   angles_ = angles;
@@ -523,28 +499,12 @@ std::optional<ScanOnGrid> scan_on_grid(const Scan2D& current, const Scan2D& refe
       window + std::min(points.max_range, points.max_range * angle_window) + 4 * resolution;
   low -= Vec2::Constant(margin);
   high += Vec2::Constant(margin);
-  // Turned about the sensor and shifted within the window, no point leaves the square of its
-  // farthest range about the guess (a 180-degree scan's footprint grown by the sweep reaches as
-  // far again behind and aside): the grid is cut to it, on the lattice of the points in the
-  // footprint, so that every score stays what it was.
-  const Vec2 reach = Vec2::Constant(window + points.max_range + 4 * resolution);
-  const Vec2 cut_low = low.cwiseMax(initial.translation() - reach);
-  const Vec2 cut_high = high.cwiseMin(initial.translation() + reach);
   std::vector<Vec2> useful;
-  Vec2 useful_low = Vec2::Constant(std::numeric_limits<double>::infinity());
-  Vec2 useful_high = -useful_low;
-  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution)) {
-    if (!(q.array() >= low.array()).all() || !(q.array() <= high.array()).all()) continue;
-    useful_low = useful_low.cwiseMin(q);
-    useful_high = useful_high.cwiseMax(q);
-    if ((q.array() >= cut_low.array()).all() && (q.array() <= cut_high.array()).all())
-      useful.push_back(q);
-  }
+  for (const Vec2& q : filled_surfaces(reference, fill_gap, resolution))
+    if ((q.array() >= low.array()).all() && (q.array() <= high.array()).all()) useful.push_back(q);
   if (useful.empty()) return std::nullopt;
   return ScanOnGrid(std::move(points.points), points.step_range,
-                    std::make_shared<LikelihoodGrid>(make_grid(
-                        useful, resolution, {}, lattice_over(useful_low, useful_high, resolution))),
-                    initial);
+                    std::make_shared<LikelihoodGrid>(make_grid(useful, resolution)), initial);
 }
 
 }  // namespace
