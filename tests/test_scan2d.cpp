@@ -390,6 +390,53 @@ TEST(Scan2D, CorrelativeMatchFindsTheBestScoreOfAnExhaustiveSearch) {
   }
 }
 
+TEST(Scan2D, CorrelativeMatchIgnoresReferencePointsNoTurnedScanReaches) {
+  // A 180-degree scan reaching 8 m, searched +-0.5 m and +-0.3 rad: no turned and shifted point
+  // lands beyond 8.5 m of the guess, so reference points beyond that (here 9.3-9.4 m ahead, inside
+  // the crop the sweep grows the footprint to) change nothing: neither a score nor the bounds'
+  // pruning. Reference points nearer than that do change the match.
+  const std::vector<Segment> walls = {{{-12, -12}, {12, -12}}, {{12, -12}, {12, 12}},
+                                      {{12, 12}, {-12, 12}},   {{-12, 12}, {-12, -12}},
+                                      {{3, -7.5}, {7, -7}},    {{5, 2}, {7.8, 2.5}},
+                                      {{-3, 4}, {-1, 4.5}},    {{4, -3}, {4.5, -1}}};
+  const auto front_scan = [&](const Pose2& pose, double max_range) {
+    Scan2D scan;
+    for (int beam = 0; beam <= 360; ++beam) {
+      const double angle = pose2_angle(pose) + (beam * 0.5 - 90.0) * M_PI / 180;
+      const Vec2 d(std::cos(angle), std::sin(angle));
+      const double range = nearest_wall(walls, pose.translation(), d);
+      if (range <= max_range)
+        scan.points.push_back(pose.inverse() * (pose.translation() + range * d));
+    }
+    return scan;
+  };
+  const Scan2D reference = front_scan(Pose2::Identity(), 7.9);
+  const auto with_wall = [&](double x) {  // a stray wall x m ahead, 1 to 7 m aside
+    Scan2D more = reference;
+    for (int i = 0; i <= 60; ++i) more.points.emplace_back(x + 0.01 * (i % 7), 1.0 + 0.1 * i);
+    return more;
+  };
+  std::size_t changed = 0;
+  for (const Pose2& truth : {pose2(0.3, 0.2, 0.05), pose2(-0.4, 0.5, -0.15)}) {
+    const Scan2D current = front_scan(truth, 8.0);
+    for (const double resolution : {0.05, 0.1})
+      for (const Pose2& guess : {truth, pose2(0.2, -0.25, 0.1) * truth}) {
+        const auto match = [&](const Scan2D& onto) {
+          return correlative_match(current, onto, guess, 0.5, 0.3, resolution, 0.0);
+        };
+        const CorrelativeMatch plain = match(reference);
+        ASSERT_TRUE(plain.found);
+        EXPECT_LT((plain.pose.translation() - truth.translation()).norm(), 0.2);
+        const CorrelativeMatch far = match(with_wall(guess.translation().x() + 9.3));
+        EXPECT_EQ(far.score, plain.score) << resolution;
+        EXPECT_TRUE(far.pose.matrix() == plain.pose.matrix()) << resolution;
+        const CorrelativeMatch near = match(with_wall(guess.translation().x() + 7.0));
+        changed += near.score != plain.score;
+      }
+  }
+  EXPECT_GT(changed, 0u);
+}
+
 TEST(Scan2D, CorrelativeMatchOnTwoReferencesFindsTheBestScoreOfAnExhaustiveSearch) {
   // A grid of the mean of two references' likelihoods (the odometry's submap): the codes of the
   // mean still bound the scores, so the branch and bound finds the exhaustive search's best. The
