@@ -28,9 +28,7 @@ Registration2DResult run_pl_icp(const Scan2D& current, const Reference2D& prepar
   std::vector<planar::LinePair> pairs;
   Registration2DResult r;
   r.transform = initial;
-  // Each iteration's result follows from the pose before it alone: once the pose returns to an
-  // earlier one, the outcome at the iteration limit is known without running there.
-  planar::IterationCycle cycle;
+  planar::IterationCycle cycle;  // a pose met again: the rest repeats
   for (r.iterations = 1; r.iterations <= o.max_iterations; ++r.iterations) {
     pairs.clear();
     for (const Vec2& point : current.points) {
@@ -74,7 +72,7 @@ Registration2DResult run_pl_icp(const Scan2D& current, const Reference2D& prepar
       r.converged = true;
       break;
     }
-    if (cycle.closes(r, o.max_iterations)) break;
+    if (cycle.closes(r, o.max_iterations)) break;  // the limit's outcome, known
   }
   r.iterations = std::min(r.iterations, o.max_iterations);
   return r;
